@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Skinpack build driver.
+#   ./build.sh          install missing packages, build library, CLI and add-on zip
+#   ./build.sh test     the above, then every test (also the C unit tests under ASan/UBSan)
+#   ./build.sh demo     the above, then the main job on the embedded default character
+set -euo pipefail
+cd "$(dirname "$0")"
+ROOT=$(pwd)
+MODE=${1:-build}
+JOBS=$(nproc 2>/dev/null || echo 2)
+
+# Debian packages the build, the tests and the benchmarks need.
+PACKAGES=(cmake make gcc g++ clang libclang-rt-14-dev python3-numpy blender libtinygltf-dev
+          glslang-tools mesa-vulkan-drivers libvulkan-dev vulkan-tools libmeshoptimizer-dev
+          gltfpack zlib1g-dev libzstd-dev zstd nodejs npm)
+
+install_packages() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "build.sh: installing ${missing[*]}"
+    local sudo=""
+    [ "$(id -u)" = 0 ] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  fi
+  # Node tools (Khronos glTF validator), pinned by tools/package-lock.json.
+  if [ -f tools/package.json ] && [ ! -d tools/node_modules ]; then
+    (cd tools && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+}
+
+build() {
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSKINPACK_SHARED_DIR="$ROOT/../shared" >/dev/null
+  cmake --build build -j "$JOBS"
+  if [ -f addon/make_zip.py ]; then
+    python3 addon/make_zip.py --library build/native/libskinpack.so --output build/skinpack_addon.zip
+  fi
+}
+
+run_tests() {
+  ctest --test-dir build --output-on-failure -j "$JOBS"
+  # The C unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer.
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DSKINPACK_SANITIZE=ON \
+        -DSKINPACK_SHARED_DIR="$ROOT/../shared" >/dev/null
+  cmake --build build-asan -j "$JOBS"
+  ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L unit
+}
+
+install_packages
+build
+case "$MODE" in
+  build) ;;
+  test) run_tests ;;
+  demo) bash scripts/demo.sh ;;
+  *) echo "usage: ./build.sh [build|test|demo]" >&2; exit 2 ;;
+esac

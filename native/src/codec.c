@@ -1,0 +1,325 @@
+/*
+ * Codec configuration (by bit budget, by target spacing, from stored parameters) and the
+ * per-method dispatch of encode and decode.
+ */
+#include <math.h>
+
+#include "codec_internal.h"
+
+static uint64_t grid_scale(uint64_t m)
+{
+    return m >= 64 ? UINT64_MAX : (((uint64_t)1 << m) - 1);
+}
+
+/* Bits of stored component c (0-based, in code order) for the grid methods. */
+static uint32_t grid_component_bits(sp_method method, uint32_t slot, uint64_t m)
+{
+    if (method != SP_METHOD_POT) return (uint32_t)m;
+    /* POT: q_i <= s/i < 2^(m - floor(log2 i)), i = slot + 1 */
+    uint32_t i = slot + 1, drop = 0;
+    while ((2u << drop) <= i) ++drop;
+    return (uint32_t)m - drop;
+}
+
+static void finish(sp_codec* codec)
+{
+    uint64_t top = codec->max_code;
+    uint32_t bits = 0;
+    while (bits < 64 && (top >> bits)) ++bits;
+    codec->bits = bits;
+    codec->code_bits = log2((double)top + 1.0);
+}
+
+static sp_result configure_grid(sp_method method, uint32_t k, uint64_t m, sp_codec* codec)
+{
+    if (m < (method == SP_METHOD_POT ? 2u : 1u) || m > 64) return SP_ERR_BITS_OUT_OF_RANGE;
+    uint32_t first = method == SP_METHOD_FIXED ? 0 : 1, total = 0;
+    for (uint32_t slot = first, c = 0; slot < k; ++slot, ++c) {
+        codec->component_bits[c] = grid_component_bits(method, slot, m);
+        total += codec->component_bits[c];
+    }
+    if (total > SP_MAX_WEIGHT_BITS) return SP_ERR_BITS_OUT_OF_RANGE;
+    codec->n = m;
+    codec->scale = grid_scale(m);
+    codec->max_code = total >= 64 ? UINT64_MAX : (((uint64_t)1 << total) - 1);
+    codec->max_spacing = 1.0 / (double)codec->scale;
+    codec->max_error = (double)(k - 1) / ((double)k * (double)codec->scale) + SP_FLOAT_SLACK;
+    return SP_OK;
+}
+
+static sp_result configure_oss(uint32_t k, uint64_t n, sp_codec* codec)
+{
+    if (n < 2 || n > ((uint64_t)1 << 63)) return SP_ERR_BITS_OUT_OF_RANGE;
+    sp_u128 count = sp_oss_code_count(n, k);
+    if (count == 0 || count - 1 > UINT64_MAX) return SP_ERR_BITS_OUT_OF_RANGE;
+    codec->n = n;
+    codec->scale = 2 * (n - 1);
+    codec->max_code = (uint64_t)(count - 1);
+    codec->max_spacing = 1.0 / (double)codec->scale;
+    codec->max_error = (double)(k - 1) / ((double)k * (double)codec->scale) + SP_FLOAT_SLACK;
+    return SP_OK;
+}
+
+static sp_result start(sp_method method, uint32_t influences, sp_codec* codec)
+{
+    if (!codec) return SP_ERR_INVALID_ARGUMENT;
+    *codec = (sp_codec){0};
+    if ((unsigned)method >= SP_METHOD_COUNT) return SP_ERR_UNSUPPORTED_METHOD;
+    if (influences < 1 || influences > SP_MAX_INFLUENCES) return SP_ERR_UNSUPPORTED_METHOD;
+    codec->method = (uint32_t)method;
+    codec->influences = influences;
+    if (influences == 1) { /* one weight is always 1: nothing to store */
+        codec->scale = 1;
+        codec->max_error = SP_FLOAT_SLACK;
+    }
+    return SP_OK;
+}
+
+/* Any AABB at a target count: isotropic lambda (paper, Sec. 4.4), then refine the coarsest
+ * axis while the product still fits, so no budget is left unused that could shrink Delta. */
+static double any_resolution(uint32_t axis, uint64_t samples)
+{
+    return (double)(axis + 2) * (double)(samples - 1); /* 1 / spacing */
+}
+
+static sp_result any_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
+{
+    uint64_t q[SP_MAX_INFLUENCES - 1];
+    uint32_t axes = k - 1;
+    sp_u128 limit = (sp_u128)1 << bits; /* bits <= 64 */
+    double volume = 1;
+    for (uint32_t a = 0; a < axes; ++a) volume /= (double)(a + 2);
+    double lambda = pow(ldexp(1.0, (int)bits) / volume, 1.0 / (double)axes);
+    sp_u128 product = 1;
+    for (uint32_t a = 0; a < axes; ++a) {
+        double qa = floor(lambda / (double)(a + 2));
+        q[a] = qa < 2 ? 2 : (qa > 0x1p62 ? ((uint64_t)1 << 62) : (uint64_t)qa);
+        product *= q[a];
+    }
+    for (int step = 0; step < 256; ++step) {
+        uint32_t coarse = 0, second = axes; /* coarsest axis, and the next coarsest */
+        for (uint32_t a = 1; a < axes; ++a)
+            if (any_resolution(a, q[a]) < any_resolution(coarse, q[coarse])) coarse = a;
+        for (uint32_t a = 0; a < axes; ++a)
+            if (a != coarse && (second == axes || any_resolution(a, q[a]) < any_resolution(second, q[second])))
+                second = a;
+        sp_u128 others = product / q[coarse];
+        if (product > limit) { /* float rounding of lambda: cut the finest axis to fit */
+            uint32_t fine = 0;
+            for (uint32_t a = 1; a < axes; ++a)
+                if (any_resolution(a, q[a]) > any_resolution(fine, q[fine])) fine = a;
+            sp_u128 fit = limit / (product / q[fine]);
+            if (fit < 2) return SP_ERR_BITS_OUT_OF_RANGE;
+            product = product / q[fine] * fit;
+            q[fine] = (uint64_t)fit;
+            continue;
+        }
+        sp_u128 room = limit / others;
+        if (room > UINT64_MAX) room = UINT64_MAX;
+        if (room <= q[coarse]) break;
+        uint64_t target = (uint64_t)room;
+        if (second < axes) { /* just past the next coarsest axis, so the two stay balanced */
+            double match = any_resolution(second, q[second]) / (double)(coarse + 2) + 2;
+            if (match < (double)target) target = (uint64_t)match;
+            if (target <= q[coarse]) target = q[coarse] + 1;
+        }
+        product = others * target;
+        q[coarse] = target;
+    }
+    return sp_any_configure(k, q, codec);
+}
+
+static sp_result oss_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
+{
+    sp_u128 limit = bits >= 64 ? (sp_u128)UINT64_MAX + 1 : ((sp_u128)1 << bits);
+    uint64_t lo = 2, hi = (uint64_t)1 << 63;
+    if (k == 3) hi = (uint64_t)1 << 34;
+    if (k == 4) hi = (uint64_t)1 << 23;
+    if (sp_oss_code_count(lo, k) > limit) return SP_ERR_BITS_OUT_OF_RANGE;
+    while (lo < hi) { /* largest N whose code count fits */
+        uint64_t mid = lo + (hi - lo + 1) / 2;
+        if (sp_oss_code_count(mid, k) <= limit) lo = mid;
+        else hi = mid - 1;
+    }
+    return configure_oss(k, lo, codec);
+}
+
+sp_result sp_codec_from_bits(sp_method method, uint32_t influences, uint32_t bits, sp_codec* codec)
+{
+    sp_result r = start(method, influences, codec);
+    if (r != SP_OK || influences == 1) return r;
+    if (bits > SP_MAX_WEIGHT_BITS) return SP_ERR_BITS_OUT_OF_RANGE;
+    uint32_t k = influences;
+    switch (method) {
+    case SP_METHOD_FIXED: r = configure_grid(method, k, bits / k, codec); break;
+    case SP_METHOD_CUBE: r = configure_grid(method, k, bits / (k - 1), codec); break;
+    case SP_METHOD_POT: {
+        /* stored bits are (k-1)m - drop with drop = 1, 2, 4 for k = 2, 3, 4 */
+        uint32_t drop = k == 2 ? 1 : (k == 3 ? 2 : 4);
+        uint64_t m = (bits + drop) / (k - 1);
+        r = configure_grid(method, k, m > 64 ? 64 : m, codec);
+        break;
+    }
+    case SP_METHOD_ANY: r = any_from_bits(k, bits, codec); break;
+    default: r = oss_from_bits(k, bits, codec); break;
+    }
+    if (r == SP_OK) finish(codec);
+    return r;
+}
+
+sp_result sp_codec_from_spacing(sp_method method, uint32_t influences, double max_spacing, sp_codec* codec)
+{
+    sp_result r = start(method, influences, codec);
+    if (r != SP_OK || influences == 1) return r;
+    if (!(max_spacing > 0) || !isfinite(max_spacing)) return SP_ERR_BITS_OUT_OF_RANGE;
+    uint32_t k = influences;
+    if (method == SP_METHOD_ANY) {
+        uint64_t q[SP_MAX_INFLUENCES - 1];
+        for (uint32_t a = 0; a + 1 < k; ++a) {
+            double need = ceil(1.0 / ((double)(a + 2) * max_spacing)) + 1;
+            if (need > 1.8e19) return SP_ERR_BITS_OUT_OF_RANGE;
+            q[a] = need < 2 ? 2 : (uint64_t)need;
+            while (q[a] > 2 && 1.0 / ((double)(a + 2) * (double)(q[a] - 2)) <= max_spacing) q[a]--;
+        }
+        r = sp_any_configure(k, q, codec);
+    } else if (method == SP_METHOD_OSS) {
+        double need = ceil(1.0 / (2.0 * max_spacing)) + 1;
+        if (need > 9.2e18) return SP_ERR_BITS_OUT_OF_RANGE;
+        uint64_t n = need < 2 ? 2 : (uint64_t)need;
+        while (n > 2 && 1.0 / (2.0 * (double)(n - 2)) <= max_spacing) n--;
+        r = configure_oss(k, n, codec);
+    } else {
+        uint64_t m = 1;
+        while (m < 64 && 1.0 / (double)grid_scale(m) > max_spacing) ++m;
+        if (1.0 / (double)grid_scale(m) > max_spacing) return SP_ERR_BITS_OUT_OF_RANGE;
+        if (method == SP_METHOD_POT && m < 2) m = 2;
+        r = configure_grid(method, k, m, codec);
+    }
+    if (r == SP_OK) finish(codec);
+    return r;
+}
+
+sp_result sp_codec_from_params(sp_method method, uint32_t influences, uint64_t n, const uint64_t* axis_samples,
+                               sp_codec* codec)
+{
+    sp_result r = start(method, influences, codec);
+    if (r != SP_OK) return r;
+    if (influences == 1) return n == 0 ? SP_OK : SP_ERR_INVALID_ARGUMENT;
+    switch (method) {
+    case SP_METHOD_ANY:
+        if (!axis_samples) return SP_ERR_INVALID_ARGUMENT;
+        r = sp_any_configure(influences, axis_samples, codec);
+        break;
+    case SP_METHOD_OSS: r = configure_oss(influences, n, codec); break;
+    default: r = configure_grid(method, influences, n, codec); break;
+    }
+    if (r == SP_OK) finish(codec);
+    return r;
+}
+
+/* ---- encode / decode ---------------------------------------------------------------- */
+
+static uint64_t encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
+{
+    uint32_t k = codec->influences;
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    uint64_t code;
+    if (k == 1) {
+        if (significant) *significant = 1;
+        return 0;
+    }
+    if (codec->method == SP_METHOD_ANY) {
+        float decoded[SP_MAX_INFLUENCES];
+        code = sp_any_encode(codec, weights);
+        if (significant) {
+            sp_any_decode(codec, code, decoded);
+            uint8_t count = 1;
+            while (count < k && decoded[count] > 0) ++count;
+            *significant = count;
+        }
+        return code;
+    }
+    sp_grid_quantize(weights, k, codec->scale, q);
+    code = codec->method == SP_METHOD_OSS ? sp_oss_pack(codec->n, k, q) : sp_grid_pack(codec, q);
+    if (significant) {
+        uint8_t count = 1;
+        while (count < k && q[count] > 0) ++count;
+        *significant = count;
+    }
+    return code;
+}
+
+uint64_t sp_encode_weights(const sp_codec* codec, const float* weights)
+{
+    return encode_one(codec, weights, NULL);
+}
+
+static void grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
+{
+    double inv = 1.0 / (double)scale;
+    for (uint32_t i = 0; i < k; ++i) weights[i] = (float)((double)q[i] * inv);
+}
+
+void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
+{
+    uint32_t k = codec->influences;
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    if (k == 1) {
+        weights[0] = 1.0f;
+    } else if (codec->method == SP_METHOD_ANY) {
+        sp_any_decode(codec, code, weights);
+    } else {
+        if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);
+        else sp_grid_unpack(codec, code, q);
+        grid_to_weights(q, k, codec->scale, weights);
+    }
+}
+
+/* A code an encoder can write: in range and, for the AABB methods, inside the simplex. */
+static int code_is_valid(const sp_codec* codec, uint64_t code)
+{
+    uint32_t k = codec->influences;
+    if (code > codec->max_code) return 0;
+    if (k == 1 || codec->method == SP_METHOD_OSS) return 1;
+    if (codec->method == SP_METHOD_ANY) {
+        float w[SP_MAX_INFLUENCES];
+        sp_any_decode(codec, code, w);
+        return w[0] >= -1e-6f;
+    }
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    uint32_t shift = 0, first = codec->method == SP_METHOD_FIXED ? 0 : 1;
+    sp_u128 sum = 0;
+    for (uint32_t i = first, c = 0; i < k; ++i, ++c) {
+        uint32_t bits = codec->component_bits[c];
+        uint64_t mask = bits >= 64 ? UINT64_MAX : (((uint64_t)1 << bits) - 1);
+        q[i] = shift < 64 ? (code >> shift) & mask : 0;
+        shift += bits;
+        sum += q[i];
+    }
+    return codec->method == SP_METHOD_FIXED ? sum == codec->scale : sum <= codec->scale;
+}
+
+sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
+                                  uint64_t* codes, uint8_t* significant)
+{
+    if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
+    uint32_t k = codec->influences;
+    for (size_t v = 0; v < vertex_count; ++v)
+        codes[v] = encode_one(codec, weights + v * k, significant ? significant + v : NULL);
+    return SP_OK;
+}
+
+sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count, float* weights,
+                                  size_t* error_vertex)
+{
+    if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
+    uint32_t k = codec->influences;
+    for (size_t v = 0; v < vertex_count; ++v) {
+        if (!code_is_valid(codec, codes[v])) {
+            if (error_vertex) *error_vertex = v;
+            return SP_ERR_CODE_OUT_OF_RANGE;
+        }
+        sp_decode_weights(codec, codes[v], weights + v * k);
+    }
+    return SP_OK;
+}

@@ -1,0 +1,62 @@
+/*
+ * Any AABB (Kuth & Meyer, Sec. 4.4): axis i (i = 2..K) spans [0, 1/i] with q_i samples; the
+ * per-axis counts are chosen so the grid is as isotropic as possible and their product fits
+ * the budget; the code is the mixed-radix index of the sample. Not on a common grid, so each
+ * axis is rounded on its own and w1 = 1 - sum.
+ */
+#include <math.h>
+
+#include "codec_internal.h"
+
+static double axis_spacing(uint32_t axis, uint64_t samples)
+{
+    return 1.0 / ((double)(axis + 2) * (double)(samples - 1));
+}
+
+uint64_t sp_any_encode(const sp_codec* codec, const float* weights)
+{
+    uint64_t code = 0, radix = 1;
+    for (uint32_t a = 0; a + 1 < codec->influences; ++a) {
+        uint64_t q = codec->axis_samples[a];
+        double x = (double)weights[a + 1] * (double)(a + 2) * (double)(q - 1) + 0.5;
+        uint64_t xi = x <= 0 ? 0 : (x >= (double)(q - 1) ? q - 1 : (uint64_t)x);
+        code += xi * radix;
+        radix *= q;
+    }
+    return code;
+}
+
+void sp_any_decode(const sp_codec* codec, uint64_t code, float* weights)
+{
+    double rest = 1.0;
+    for (uint32_t a = 0; a + 1 < codec->influences; ++a) {
+        uint64_t q = codec->axis_samples[a];
+        double w = (double)(code % q) * axis_spacing(a, q);
+        code /= q;
+        weights[a + 1] = (float)w;
+        rest -= w;
+    }
+    weights[0] = (float)rest;
+}
+
+sp_result sp_any_configure(uint32_t influences, const uint64_t* axis_samples, sp_codec* codec)
+{
+    sp_u128 count = 1;
+    double spacing = 0, w1_error = 0;
+    for (uint32_t a = 0; a + 1 < influences; ++a) {
+        uint64_t q = axis_samples[a];
+        if (q < 2) return SP_ERR_INVALID_ARGUMENT;
+        count *= q;
+        if (count > ((sp_u128)1 << 64)) return SP_ERR_BITS_OUT_OF_RANGE;
+        double h = axis_spacing(a, q);
+        if (h > spacing) spacing = h;
+        w1_error += h / 2;
+        codec->axis_samples[a] = q;
+    }
+    codec->n = 0;
+    codec->scale = 0;
+    codec->max_code = (uint64_t)(count - 1); /* count <= 2^64, so max_code fits */
+    codec->max_spacing = spacing;
+    codec->max_error = w1_error + SP_FLOAT_SLACK;
+    return SP_OK;
+}

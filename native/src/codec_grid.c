@@ -1,0 +1,116 @@
+/*
+ * Grid codecs: Fixed, Unit Cube and POT AABB, plus the largest-remainder rounding they share
+ * with OSS. All four place the weights on the integer grid q/s with q summing to s, so the
+ * decoded tuple is sorted, non-negative and sums to exactly one.
+ */
+#include "codec_internal.h"
+
+/* Slot order by descending remainder, ties to the lower slot (stable insertion sort). */
+static void order_by_remainder(const double* remainder, uint32_t k, uint32_t* order)
+{
+    for (uint32_t i = 0; i < k; ++i) {
+        uint32_t j = i;
+        while (j > 0 && remainder[order[j - 1]] < remainder[i]) {
+            order[j] = order[j - 1];
+            --j;
+        }
+        order[j] = i;
+    }
+}
+
+/* floor(x) for 0 <= x, clamped to [0, limit]; long double keeps all 64 bits of large grids. */
+static uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
+{
+    if (!(x > 0)) {
+        *remainder = 0;
+        return 0;
+    }
+    if (x >= (long double)limit) {
+        *remainder = 0;
+        return limit;
+    }
+    uint64_t f = (uint64_t)x;
+    *remainder = (double)(x - (long double)f);
+    return f;
+}
+
+void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
+{
+    double remainder[SP_MAX_INFLUENCES];
+    uint32_t order[SP_MAX_INFLUENCES];
+    double sum = 0;
+    for (uint32_t i = 0; i < k; ++i) sum += weights[i];
+    if (!(sum > 0)) sum = 1;
+
+    sp_u128 total = 0;
+    if (s < ((uint64_t)1 << 50)) {
+        /* Fast path: double holds x exactly enough for any grid below 2^50. */
+        double scale = (double)s / sum;
+        for (uint32_t i = 0; i < k; ++i) {
+            double x = weights[i] * scale;
+            if (!(x > 0)) x = 0;                      /* also maps NaN to 0 */
+            uint64_t f = (uint64_t)x;                 /* floor for x >= 0, no libm call */
+            if (f > s) f = s;
+            q[i] = f;
+            remainder[i] = x - (double)f;
+            total += f;
+        }
+    } else {
+        long double scale = (long double)s / (long double)sum;
+        for (uint32_t i = 0; i < k; ++i) {
+            q[i] = floor_clamped((long double)weights[i] * scale, s, &remainder[i]);
+            total += q[i];
+        }
+    }
+
+    order_by_remainder(remainder, k, order);
+    /* The deficit is 0..k-1 for exact input; the loops also absorb rounding of huge grids. */
+    for (uint32_t t = 0; total < s; ++t, ++total) q[order[t % k]]++;
+    for (uint32_t t = 0; total > s; ++t) {
+        uint32_t slot = order[k - 1 - t % k];
+        if (q[slot] > 0) {
+            q[slot]--;
+            --total;
+        }
+    }
+    /* Keep descending order even where the rounding loops above had to wrap around. */
+    for (uint32_t i = 1; i < k; ++i)
+        for (uint32_t j = i; j > 0 && q[j - 1] < q[j]; --j) {
+            uint64_t t = q[j];
+            q[j] = q[j - 1];
+            q[j - 1] = t;
+        }
+}
+
+/* Stored components: Fixed stores q[0..k-1], Cube and POT q[1..k-1]. */
+static uint32_t first_stored(const sp_codec* codec)
+{
+    return codec->method == SP_METHOD_FIXED ? 0 : 1;
+}
+
+uint64_t sp_grid_pack(const sp_codec* codec, const uint64_t* q)
+{
+    uint64_t code = 0;
+    uint32_t shift = 0;
+    for (uint32_t i = first_stored(codec), c = 0; i < codec->influences; ++i, ++c) {
+        if (shift < 64) code |= q[i] << shift;
+        shift += codec->component_bits[c];
+    }
+    return code;
+}
+
+void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q)
+{
+    uint32_t shift = 0;
+    uint64_t rest = codec->scale;
+    for (uint32_t i = first_stored(codec), c = 0; i < codec->influences; ++i, ++c) {
+        uint32_t bits = codec->component_bits[c];
+        uint64_t mask = bits >= 64 ? ~(uint64_t)0 : (((uint64_t)1 << bits) - 1);
+        q[i] = shift < 64 ? (code >> shift) & mask : 0;
+        shift += bits;
+        if (i > 0) rest = rest >= q[i] ? rest - q[i] : 0;
+    }
+    /* Cube/POT drop the largest weight: it is whatever the grid has left (0 for the invalid
+     * tuples of the AABB corners, which no encoder writes and sp_code_is_valid rejects). */
+    if (codec->method != SP_METHOD_FIXED) q[0] = rest;
+}
