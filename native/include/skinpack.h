@@ -134,6 +134,11 @@ SP_API sp_result sp_codec_from_spacing(sp_method method, uint32_t influences, do
  * this is how a decoder rebuilds the codec from a file. */
 SP_API sp_result sp_codec_from_params(sp_method method, uint32_t influences, uint64_t n,
                                       const uint64_t* axis_samples, sp_codec* codec);
+/* Bits a method needs to reach a sample spacing, without the 64-bit limit of a code (for
+ * comparisons such as the paper's Table 2): *bits is the integer code width, *code_bits
+ * log2 of the code count. */
+SP_API sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spacing, uint32_t* bits,
+                                  double* code_bits);
 /* Short lower-case method name ("fixed", "cube", "pot", "any", "oss"); NULL if unknown. */
 SP_API const char* sp_method_name(sp_method method);
 /* Parses a method name; returns SP_METHOD_COUNT if unknown. */

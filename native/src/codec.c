@@ -217,6 +217,49 @@ sp_result sp_codec_from_params(sp_method method, uint32_t influences, uint64_t n
     return r;
 }
 
+static uint32_t ceil_bits(double code_bits)
+{
+    double whole = ceil(code_bits - 1e-9);
+    return (uint32_t)(whole < 0 ? 0 : whole);
+}
+
+sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spacing, uint32_t* bits,
+                           double* code_bits)
+{
+    sp_codec scratch;
+    sp_result r = start(method, influences, &scratch);
+    if (r != SP_OK) return r;
+    if (!bits || !code_bits || !(max_spacing > 1e-30) || !isfinite(max_spacing)) return SP_ERR_INVALID_ARGUMENT;
+    uint32_t k = influences;
+    double total = 0;
+    if (k == 1) {
+        total = 0;
+    } else if (method == SP_METHOD_ANY || method == SP_METHOD_OSS) {
+        /* the same sample counts sp_codec_from_spacing picks, counted in log2 */
+        if (method == SP_METHOD_OSS) {
+            double n = ceil(1.0 / (2.0 * max_spacing)) + 1;
+            while (n > 2 && 1.0 / (2.0 * (n - 2)) <= max_spacing) n -= 1;
+            if (n > 0x1p40) return SP_ERR_BITS_OUT_OF_RANGE;
+            total = log2((double)sp_oss_code_count((uint64_t)n, k));
+        } else {
+            for (uint32_t a = 0; a + 1 < k; ++a) {
+                double q = ceil(1.0 / ((double)(a + 2) * max_spacing)) + 1;
+                while (q > 2 && 1.0 / ((double)(a + 2) * (q - 2)) <= max_spacing) q -= 1;
+                total += log2(q);
+            }
+        }
+    } else {
+        int m = 1;
+        while (m < 1000 && 1.0 / (ldexp(1.0, m) - 1) > max_spacing) ++m;
+        if (method == SP_METHOD_POT && m < 2) m = 2;
+        for (uint32_t slot = method == SP_METHOD_FIXED ? 0 : 1; slot < k; ++slot)
+            total += grid_component_bits(method, slot, (uint64_t)m);
+    }
+    *code_bits = total;
+    *bits = ceil_bits(total);
+    return SP_OK;
+}
+
 /* ---- encode / decode ---------------------------------------------------------------- */
 
 static uint64_t encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
