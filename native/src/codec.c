@@ -262,9 +262,10 @@ sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spa
 
 /* ---- encode / decode ---------------------------------------------------------------- */
 
-static uint64_t encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
+/* Inlined with a constant k by the batch loop below. */
+static inline __attribute__((always_inline)) uint64_t encode_one(const sp_codec* codec, const float* weights,
+                                                                 uint32_t k, uint8_t* significant)
 {
-    uint32_t k = codec->influences;
     uint64_t q[SP_MAX_INFLUENCES] = {0};
     uint64_t code;
     if (k == 1) {
@@ -294,7 +295,7 @@ static uint64_t encode_one(const sp_codec* codec, const float* weights, uint8_t*
 
 uint64_t sp_encode_weights(const sp_codec* codec, const float* weights)
 {
-    return encode_one(codec, weights, NULL);
+    return encode_one(codec, weights, codec->influences, NULL);
 }
 
 static void grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
@@ -347,8 +348,16 @@ sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, s
 {
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
-    for (size_t v = 0; v < vertex_count; ++v)
-        codes[v] = encode_one(codec, weights + v * k, significant ? significant + v : NULL);
+#define SP_ENCODE_LOOP(K)                                                                            \
+    for (size_t v = 0; v < vertex_count; ++v)                                                       \
+        codes[v] = encode_one(codec, weights + v * (K), (K), significant ? significant + v : NULL);
+    switch (k) {
+    case 2: SP_ENCODE_LOOP(2) break;
+    case 3: SP_ENCODE_LOOP(3) break;
+    case 4: SP_ENCODE_LOOP(4) break;
+    default: SP_ENCODE_LOOP(k) break;
+    }
+#undef SP_ENCODE_LOOP
     return SP_OK;
 }
 

@@ -34,7 +34,8 @@ static uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
     return f;
 }
 
-void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
+/* General rounding: any grid size, any deficit (also the rare wrap-around of huge grids). */
+static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     double remainder[SP_MAX_INFLUENCES];
     uint32_t order[SP_MAX_INFLUENCES];
@@ -43,28 +44,12 @@ void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
     if (!(sum > 0)) sum = 1;
 
     sp_u128 total = 0;
-    if (s < ((uint64_t)1 << 50)) {
-        /* Fast path: double holds x exactly enough for any grid below 2^50. */
-        double scale = (double)s / sum;
-        for (uint32_t i = 0; i < k; ++i) {
-            double x = weights[i] * scale;
-            if (!(x > 0)) x = 0;                      /* also maps NaN to 0 */
-            uint64_t f = (uint64_t)x;                 /* floor for x >= 0, no libm call */
-            if (f > s) f = s;
-            q[i] = f;
-            remainder[i] = x - (double)f;
-            total += f;
-        }
-    } else {
-        long double scale = (long double)s / (long double)sum;
-        for (uint32_t i = 0; i < k; ++i) {
-            q[i] = floor_clamped((long double)weights[i] * scale, s, &remainder[i]);
-            total += q[i];
-        }
+    long double scale = (long double)s / (long double)sum;
+    for (uint32_t i = 0; i < k; ++i) {
+        q[i] = floor_clamped((long double)weights[i] * scale, s, &remainder[i]);
+        total += q[i];
     }
-
     order_by_remainder(remainder, k, order);
-    /* The deficit is 0..k-1 for exact input; the loops also absorb rounding of huge grids. */
     for (uint32_t t = 0; total < s; ++t, ++total) q[order[t % k]]++;
     for (uint32_t t = 0; total > s; ++t) {
         uint32_t slot = order[k - 1 - t % k];
@@ -80,6 +65,11 @@ void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
             q[j] = q[j - 1];
             q[j - 1] = t;
         }
+}
+
+void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
+{
+    quantize_general(weights, k, s, q);
 }
 
 /* Stored components: Fixed stores q[0..k-1], Cube and POT q[1..k-1]. */

@@ -10,8 +10,43 @@ typedef unsigned __int128 sp_u128;
 /* Float rounding of the input weights and of the decoded floats, added to every bound. */
 #define SP_FLOAT_SLACK 3.6e-7
 
-/* Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s. */
-void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q);
+/* Largest-remainder rounding for any grid and any deficit (the slow, general path). */
+void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q);
+
+/*
+ * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s.
+ * Inlined so that callers with a constant k get unrolled, branch-free code: for grids below
+ * 2^50 (double is exact enough) floor by conversion, then add one to the d largest remainders
+ * chosen by rank instead of by sorting.
+ */
+static inline __attribute__((always_inline)) void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s,
+                                                                   uint64_t* q)
+{
+    if (s < ((uint64_t)1 << 50)) {
+        double remainder[SP_MAX_INFLUENCES], sum = 0;
+        for (uint32_t i = 0; i < k; ++i) sum += weights[i];
+        double scale = (double)s / sum;
+        int64_t deficit = (int64_t)s;
+        for (uint32_t i = 0; i < k; ++i) {
+            double x = weights[i] * scale;
+            x = x > 0 ? x : 0; /* also maps NaN to 0 */
+            int64_t f = (int64_t)x;
+            q[i] = (uint64_t)f;
+            remainder[i] = x - (double)f;
+            deficit -= f;
+        }
+        if (deficit >= 0 && deficit < (int64_t)k) {
+            for (uint32_t i = 0; i < k; ++i) {
+                int64_t rank = 0; /* components that win the bump before i: larger, or equal and lower */
+                for (uint32_t j = 0; j < k; ++j)
+                    rank += (remainder[j] > remainder[i]) | ((remainder[j] == remainder[i]) & (j < i));
+                q[i] += (uint64_t)(rank < deficit);
+            }
+            return;
+        }
+    }
+    sp_grid_quantize_general(weights, k, s, q);
+}
 
 /* Fixed/Cube/POT: pack and unpack the integer grid coordinates q[0..k-1] (q[0] = largest). */
 uint64_t sp_grid_pack(const sp_codec* codec, const uint64_t* q);

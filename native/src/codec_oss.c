@@ -8,6 +8,7 @@
  * integer base indices (the paper's off-by-one fix, done as a bounded search).
  */
 #include <math.h>
+#include <string.h>
 
 #include "codec_internal.h"
 
@@ -79,9 +80,17 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 static uint64_t oss_find_row(uint64_t n, uint64_t w)
 {
     uint64_t rows = (2 * n + 1) / 3;
-    sp_u128 two_n1 = 2 * (sp_u128)n + 1;
-    double mirrored = (double)(two_n1 * two_n1 + 3 - 12 * (sp_u128)w);
-    double estimate = ((double)two_n1 - sqrt(mirrored)) / 3.0;
+    double mirrored, apex;
+    if (n < OSS_SMALL_N) {
+        uint64_t two_n1 = 2 * n + 1;
+        mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w);
+        apex = (double)two_n1;
+    } else {
+        sp_u128 two_n1 = 2 * (sp_u128)n + 1;
+        mirrored = (double)(two_n1 * two_n1 + 3 - 12 * (sp_u128)w);
+        apex = (double)two_n1;
+    }
+    double estimate = (apex - sqrt(mirrored)) / 3.0;
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
     while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
@@ -92,13 +101,32 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w)
 /* Largest layer k with u(k) <= code. With M = N + 1, 72(u~((N+1)/2) - code) equals
  * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
  * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
+/* Cube root of x >= 1 to ~1e-12: exponent/3 bit trick, then three Newton steps. The layer
+ * search below only needs the estimate to within a layer, and libm's cbrt costs ~4x more. */
+static inline double cube_root(double x)
+{
+    uint64_t bits;
+    double y;
+    memcpy(&bits, &x, sizeof(bits));
+    bits = bits / 3 + 0x2A9F7893782DA1CEull;
+    memcpy(&y, &bits, sizeof(y));
+    for (int i = 0; i < 3; ++i) y -= (y * y * y - x) / (3 * y * y);
+    return y;
+}
+
 static uint64_t oss_find_layer(uint64_t n, uint64_t code)
 {
     uint64_t layers = (n + 1) / 2;
-    sp_u128 m = (sp_u128)n + 1;
-    double v = (double)(4 * m * m * m + 6 * m * m + 16 - 72 * (sp_u128)code);
+    double v;
+    if (n < OSS_SMALL_N) { /* everything below 2^63: no 128-bit conversions */
+        uint64_t m = n + 1;
+        v = (double)(int64_t)(4 * m * m * m + 6 * m * m + 16 - 72 * code);
+    } else {
+        sp_u128 m = (sp_u128)n + 1;
+        v = (double)(4 * m * m * m + 6 * m * m + 16 - 72 * (sp_u128)code);
+    }
     double root = v > 2 ? sqrt(v * (v - 2)) : 0;
-    double c = cbrt(v - 1 + root);
+    double c = n < OSS_SMALL_N ? cube_root(v - 1 + root) : cbrt(v - 1 + root);
     if (c < 1) c = 1;
     double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
     uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;

@@ -1,0 +1,99 @@
+/*
+ * meshlets_internal.h - state shared by the meshlet builders (private to native/src/meshlets*.c).
+ *
+ * Every builder decides only which triangle goes next and when a meshlet is closed; the
+ * bookkeeping of the open meshlet (local vertex and palette slots) and writing it out
+ * (vertices, triangles, palette, local tuple LUT, bounds) is common and lives in
+ * meshlets_common_util.c. All arrays below point into the caller's scratch buffer.
+ */
+#ifndef SKINPACK_MESHLETS_INTERNAL_H
+#define SKINPACK_MESHLETS_INTERNAL_H
+
+#include "skinpack.h"
+
+#define SP_MESHLET_NO_SLOT 0xff /* vertex_slot / joint_slot: not in the open meshlet */
+#define SP_JOINT_SLOT_COUNT 65536
+
+typedef struct sp_meshlet_context {
+    /* input */
+    const uint32_t* indices;
+    size_t triangle_count;
+    const float* positions;
+    size_t position_stride; /* in floats */
+    size_t vertex_count;
+    const uint16_t* joints;
+    const float* weights;
+    size_t influences;
+    sp_meshlet_options options;
+
+    /* per triangle: its distinct used joints, ascending (SP_MESHLET_TRIANGLE_JOINTS slots) */
+    uint16_t* triangle_joints;
+    uint8_t* triangle_joint_count;
+
+    /* the open meshlet */
+    uint8_t* vertex_slot;  /* vertex_count entries */
+    uint8_t* joint_slot;   /* SP_JOINT_SLOT_COUNT entries */
+    uint32_t* open_triangles; /* max_triangles entries */
+    uint32_t open_vertices[SP_MESHLET_MAX_VERTICES];
+    uint16_t open_joints[SP_MESHLET_MAX_JOINTS];
+    uint32_t open_triangle_count, open_vertex_count, open_joint_count;
+    float open_position_sum[3]; /* sum of the open vertices' positions: their centroid drives proximity */
+
+    /* output */
+    sp_meshlet_buffers* out;
+    sp_meshlet_sizes used;
+
+    /* scratch not consumed by the common part, for the builder */
+    unsigned char* builder_scratch;
+    size_t builder_scratch_size;
+} sp_meshlet_context;
+
+/* Scratch bytes the common part needs, and what each builder needs on top of it. */
+size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles);
+size_t sp_meshlet_common_builder_scratch_bound(size_t triangle_count);
+size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count);
+
+/* Fills triangle_joints; fails with SP_ERR_LIMIT_EXCEEDED naming the first triangle over max_joints. */
+sp_result sp_meshlet_collect_triangle_joints(sp_meshlet_context* ctx, size_t* error_triangle);
+
+/* New vertices triangle t would add to the open meshlet (inline: the builders' inner loop). */
+static inline uint32_t sp_meshlet_new_vertices(const sp_meshlet_context* ctx, size_t t)
+{
+    uint32_t a = ctx->indices[t * 3 + 0], b = ctx->indices[t * 3 + 1], c = ctx->indices[t * 3 + 2];
+    /* degenerate triangles repeat a vertex: count it once */
+    return (ctx->vertex_slot[a] == SP_MESHLET_NO_SLOT) + (ctx->vertex_slot[b] == SP_MESHLET_NO_SLOT && b != a) +
+           (ctx->vertex_slot[c] == SP_MESHLET_NO_SLOT && c != a && c != b);
+}
+
+/* New palette joints triangle t would add to the open meshlet. */
+static inline uint32_t sp_meshlet_new_joints(const sp_meshlet_context* ctx, size_t t)
+{
+    const uint16_t* list = ctx->triangle_joints + t * SP_MESHLET_TRIANGLE_JOINTS;
+    uint32_t count = ctx->triangle_joint_count[t], fresh = 0;
+    for (uint32_t i = 0; i < count; ++i)
+        fresh += ctx->joint_slot[list[i]] == SP_MESHLET_NO_SLOT;
+    return fresh;
+}
+
+/* Whether t can join the open meshlet without breaking a limit. */
+int sp_meshlet_fits(const sp_meshlet_context* ctx, size_t t);
+/* Adds t to the open meshlet (the caller checked sp_meshlet_fits). */
+void sp_meshlet_add(sp_meshlet_context* ctx, size_t t);
+/* Writes the open meshlet (if it has triangles) to the output and empties it. */
+void sp_meshlet_flush(sp_meshlet_context* ctx);
+/* Greedy in the given order (NULL: index order): close the meshlet when the next triangle does
+ * not fit. Flushes at the end. This is the thesis's GenerateMeshlets. */
+void sp_meshlet_greedy(sp_meshlet_context* ctx, const uint32_t* order, size_t count);
+
+/* Position of vertex v. */
+static inline const float* sp_meshlet_position(const sp_meshlet_context* ctx, uint32_t v)
+{
+    return ctx->positions + (size_t)v * ctx->position_stride;
+}
+
+/* The builders. */
+void sp_meshlets_build_naive(sp_meshlet_context* ctx);
+void sp_meshlets_build_common(sp_meshlet_context* ctx);
+void sp_meshlets_build_skin(sp_meshlet_context* ctx);
+
+#endif /* SKINPACK_MESHLETS_INTERNAL_H */

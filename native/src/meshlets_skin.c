@@ -1,0 +1,316 @@
+/*
+ * meshlets_skin.c - our skin-aware builder.
+ *
+ * Grows one meshlet at a time like meshopt_buildMeshlets: the next triangle is the best live
+ * triangle adjacent to the meshlet's vertices; when the meshlet's surface patch runs out, the
+ * nearest free triangle (searched in a widening window of the Morton order of triangle
+ * centroids, where meshopt uses a k-d tree) continues it. The score adds skinning to meshoptimizer's: a candidate costs its new vertices
+ * (0 if it adds none, 1 if it completes a vertex's fan) plus joint_cost per joint it would add
+ * to the palette, so a meshlet fills up inside one region of the skeleton before it crosses into
+ * the next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet is closed when
+ * no adjacent triangle fits a limit, and the next one starts from the best of those misfits, so
+ * consecutive meshlets stay neighbours and leave no scattered leftovers behind.
+ */
+#include "meshlets_internal.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NO_TRIANGLE UINT32_MAX
+#define PROXIMITY_WINDOW 32       /* Morton neighbours searched on each side when a patch runs out, */
+#define PROXIMITY_WINDOW_MAX 2048 /* widened 8x at a time up to this */
+#define JUMP_JOINT_PENALTY 4.0f   /* distance factor per new joint (x joint_cost) for such jumps */
+
+typedef struct skin_state {
+    uint32_t* adjacency_offset; /* vertex_count + 1: start of each vertex's triangle list */
+    uint32_t* adjacency;        /* the triangles around each vertex; the first live[v] are not emitted yet */
+    uint32_t* live;             /* vertex_count */
+    uint8_t* emitted;           /* triangle_count */
+    float* centroid;            /* 3 per triangle */
+    uint64_t* morton;           /* Morton code << 32 | triangle, ascending */
+    uint32_t* rank;             /* triangle -> position in morton[] */
+    size_t seed_cursor;         /* morton[] before this position is all emitted */
+    uint32_t last_rank;         /* rank of the triangle added last */
+} skin_state;
+
+static size_t align8(size_t bytes)
+{
+    return (bytes + 7) & ~(size_t)7;
+}
+
+size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
+{
+    return align8((vertex_count + 1) * sizeof(uint32_t)) + align8(triangle_count * 3 * sizeof(uint32_t)) +
+           align8(vertex_count * sizeof(uint32_t)) + align8(triangle_count) + align8(triangle_count * 3 * sizeof(float)) +
+           align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t));
+}
+
+static void* carve(unsigned char** cursor, size_t bytes)
+{
+    void* block = *cursor;
+    *cursor += align8(bytes);
+    return block;
+}
+
+/* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
+static int distinct_corner(const uint32_t* tri, int c)
+{
+    return (c == 0) || (c == 1 && tri[1] != tri[0]) || (c == 2 && tri[2] != tri[0] && tri[2] != tri[1]);
+}
+
+static void build_adjacency(const sp_meshlet_context* ctx, skin_state* s)
+{
+    memset(s->live, 0, ctx->vertex_count * sizeof(uint32_t));
+    for (size_t t = 0; t < ctx->triangle_count; ++t)
+        for (int c = 0; c < 3; ++c)
+            if (distinct_corner(ctx->indices + t * 3, c))
+                s->live[ctx->indices[t * 3 + c]]++;
+    uint32_t offset = 0;
+    for (size_t v = 0; v < ctx->vertex_count; ++v) {
+        s->adjacency_offset[v] = offset;
+        offset += s->live[v];
+        s->live[v] = 0;
+    }
+    s->adjacency_offset[ctx->vertex_count] = offset;
+    for (size_t t = 0; t < ctx->triangle_count; ++t)
+        for (int c = 0; c < 3; ++c)
+            if (distinct_corner(ctx->indices + t * 3, c)) {
+                uint32_t v = ctx->indices[t * 3 + c];
+                s->adjacency[s->adjacency_offset[v] + s->live[v]++] = (uint32_t)t;
+            }
+}
+
+/* 10 bits per axis interleaved: z y x z y x ... */
+static uint32_t spread_bits(uint32_t x)
+{
+    x &= 0x3ff;
+    x = (x | x << 16) & 0x030000ff;
+    x = (x | x << 8) & 0x0300f00f;
+    x = (x | x << 4) & 0x030c30c3;
+    x = (x | x << 2) & 0x09249249;
+    return x;
+}
+
+static int compare_u64(const void* a, const void* b)
+{
+    uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
+    return (x > y) - (x < y);
+}
+
+static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
+{
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (size_t t = 0; t < ctx->triangle_count; ++t) {
+        float* c = s->centroid + t * 3;
+        c[0] = c[1] = c[2] = 0.0f;
+        for (int k = 0; k < 3; ++k) {
+            const float* p = sp_meshlet_position(ctx, ctx->indices[t * 3 + k]);
+            for (int i = 0; i < 3; ++i)
+                c[i] += p[i] / 3.0f;
+        }
+        for (int i = 0; i < 3; ++i) {
+            lo[i] = c[i] < lo[i] ? c[i] : lo[i];
+            hi[i] = c[i] > hi[i] ? c[i] : hi[i];
+        }
+    }
+    float extent = 0.0f;
+    for (int i = 0; i < 3; ++i)
+        extent = hi[i] - lo[i] > extent ? hi[i] - lo[i] : extent;
+    float scale = extent > 0.0f ? 1023.0f / extent : 0.0f;
+    for (size_t t = 0; t < ctx->triangle_count; ++t) {
+        const float* c = s->centroid + t * 3;
+        uint32_t code = 0;
+        for (int i = 0; i < 3; ++i) {
+            float q = (c[i] - lo[i]) * scale; /* NaN positions land in cell 0 */
+            code |= spread_bits(q > 0.0f ? (uint32_t)(q + 0.5f) : 0u) << i;
+        }
+        s->morton[t] = (uint64_t)code << 32 | t;
+    }
+    qsort(s->morton, ctx->triangle_count, sizeof(uint64_t), compare_u64);
+    for (size_t i = 0; i < ctx->triangle_count; ++i)
+        s->rank[(uint32_t)s->morton[i]] = (uint32_t)i;
+}
+
+static void open_centroid(const sp_meshlet_context* ctx, float* point)
+{
+    for (int i = 0; i < 3; ++i)
+        point[i] = ctx->open_position_sum[i] / (float)ctx->open_vertex_count;
+}
+
+static float distance_to(const skin_state* s, uint32_t t, const float* point)
+{
+    const float* c = s->centroid + (size_t)t * 3;
+    float d[3] = {c[0] - point[0], c[1] - point[1], c[2] - point[2]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+/* Adds t to the open meshlet and takes it out of its vertices' live lists. */
+static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
+{
+    sp_meshlet_add(ctx, t);
+    s->emitted[t] = 1;
+    s->last_rank = s->rank[t];
+    for (int c = 0; c < 3; ++c) {
+        if (!distinct_corner(ctx->indices + t * 3, c))
+            continue;
+        uint32_t v = ctx->indices[t * 3 + c];
+        uint32_t* list = s->adjacency + s->adjacency_offset[v];
+        for (uint32_t i = 0; i < s->live[v]; ++i)
+            if (list[i] == t) {
+                list[i] = list[--s->live[v]];
+                list[s->live[v]] = t;
+                break;
+            }
+    }
+}
+
+typedef struct candidate {
+    uint32_t triangle;
+    float cost;     /* priority + joint_cost * new joints: lower is better */
+    float distance; /* squared, centroid to the meshlet's centroid: meshopt's tie-break */
+} candidate;
+
+static int better(const candidate* a, const candidate* b)
+{
+    if (b->triangle == NO_TRIANGLE)
+        return 1;
+    if (a->cost != b->cost)
+        return a->cost < b->cost;
+    if (a->distance != b->distance)
+        return a->distance < b->distance;
+    return a->triangle < b->triangle;
+}
+
+/* meshoptimizer's topological priority: 0 when t adds no vertex, 1 when it completes a
+ * vertex's fan (that vertex then leaves the meshlet border), else new vertices + 1. */
+static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_t new_vertices)
+{
+    if (new_vertices == 0)
+        return 0.0f;
+    return (s->live[tri[0]] == 1 || s->live[tri[1]] == 1 || s->live[tri[2]] == 1) ? 1.0f : new_vertices + 1.0f;
+}
+
+/* Best live triangle next to the open meshlet; with require_fit only those that fit every
+ * limit. The joint term is never negative, so a candidate whose topology alone is worse than
+ * the best so far is skipped before its joints are counted. */
+static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
+{
+    candidate best = {NO_TRIANGLE, 0.0f, 0.0f};
+    if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
+        return best;
+    float point[3];
+    open_centroid(ctx, point);
+    for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
+        uint32_t v = ctx->open_vertices[i];
+        const uint32_t* list = s->adjacency + s->adjacency_offset[v];
+        for (uint32_t j = 0; j < s->live[v]; ++j) {
+            uint32_t t = list[j];
+            const uint32_t* tri = ctx->indices + (size_t)t * 3;
+            uint32_t new_vertices = sp_meshlet_new_vertices(ctx, t);
+            if (require_fit && ctx->open_vertex_count + new_vertices > ctx->options.max_vertices)
+                continue;
+            float priority = topology_priority(s, tri, new_vertices);
+            if (best.triangle != NO_TRIANGLE && priority > best.cost)
+                continue;
+            uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
+            if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
+                continue;
+            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            if (best.triangle != NO_TRIANGLE && cost > best.cost)
+                continue;
+            candidate c = {t, cost, distance_to(s, t, point)};
+            if (better(&c, &best))
+                best = c;
+        }
+    }
+    return best;
+}
+
+/* Nearest free triangle to point among the Morton neighbours of the last triangle added,
+ * widening the window until one is found (or the widest window is spent); with require_fit
+ * only triangles that fit the open meshlet, their distance scaled up by the joints they add. */
+static uint32_t nearest_free(const sp_meshlet_context* ctx, const skin_state* s, const float* point, int require_fit)
+{
+    for (size_t window = PROXIMITY_WINDOW; window <= PROXIMITY_WINDOW_MAX; window *= 8) {
+        size_t lo = s->last_rank > window ? s->last_rank - window : 0;
+        size_t hi = s->last_rank + window + 1 < ctx->triangle_count ? s->last_rank + window + 1 : ctx->triangle_count;
+        uint32_t best = NO_TRIANGLE;
+        float best_distance = FLT_MAX;
+        for (size_t r = lo; r < hi; ++r) {
+            uint32_t t = (uint32_t)s->morton[r];
+            if (s->emitted[t] || (require_fit && !sp_meshlet_fits(ctx, t)))
+                continue;
+            float distance = distance_to(s, t, point);
+            if (require_fit) /* a jump that widens the palette counts as farther */
+                distance *= 1.0f + JUMP_JOINT_PENALTY * ctx->options.joint_cost * (float)sp_meshlet_new_joints(ctx, t);
+            if (distance < best_distance) { /* ties: lower Morton rank, as scanned */
+                best = t;
+                best_distance = distance;
+            }
+        }
+        if (best != NO_TRIANGLE || (lo == 0 && hi == ctx->triangle_count))
+            return best;
+    }
+    return NO_TRIANGLE;
+}
+
+/* First free triangle in Morton order: where a new meshlet starts when nothing is near. */
+static uint32_t next_seed(const sp_meshlet_context* ctx, skin_state* s)
+{
+    while (s->seed_cursor < ctx->triangle_count && s->emitted[(uint32_t)s->morton[s->seed_cursor]])
+        ++s->seed_cursor;
+    return (uint32_t)s->morton[s->seed_cursor];
+}
+
+void sp_meshlets_build_skin(sp_meshlet_context* ctx)
+{
+    unsigned char* cursor = ctx->builder_scratch;
+    size_t t_count = ctx->triangle_count, v_count = ctx->vertex_count;
+    skin_state s;
+    s.adjacency_offset = carve(&cursor, (v_count + 1) * sizeof(uint32_t));
+    s.adjacency = carve(&cursor, t_count * 3 * sizeof(uint32_t));
+    s.live = carve(&cursor, v_count * sizeof(uint32_t));
+    s.emitted = carve(&cursor, t_count);
+    s.centroid = carve(&cursor, t_count * 3 * sizeof(float));
+    s.morton = carve(&cursor, t_count * sizeof(uint64_t));
+    s.rank = carve(&cursor, t_count * sizeof(uint32_t));
+    s.seed_cursor = 0;
+    s.last_rank = 0;
+    memset(s.emitted, 0, t_count);
+    build_adjacency(ctx, &s);
+    build_spatial_order(ctx, &s);
+
+    for (size_t done = 0; done < t_count; ++done) {
+        if (ctx->open_triangle_count == 0) {
+            emit(ctx, &s, next_seed(ctx, &s));
+            continue;
+        }
+        candidate fitting = best_neighbour(ctx, &s, 1);
+        if (fitting.triangle != NO_TRIANGLE) {
+            emit(ctx, &s, fitting.triangle);
+            continue;
+        }
+        candidate any = best_neighbour(ctx, &s, 0);
+        if (any.triangle != NO_TRIANGLE) {
+            /* the patch goes on but the meshlet is full: the next meshlet continues from here */
+            sp_meshlet_flush(ctx);
+            emit(ctx, &s, any.triangle);
+            continue;
+        }
+        /* the surface patch is used up: jump to the nearest free triangle, into this meshlet if
+         * it has room for one more disconnected triangle (3 new vertices), else into the next */
+        float point[3];
+        open_centroid(ctx, point);
+        uint32_t near = NO_TRIANGLE;
+        if (ctx->open_vertex_count + 3 <= ctx->options.max_vertices &&
+            ctx->open_triangle_count < ctx->options.max_triangles)
+            near = nearest_free(ctx, &s, point, 1);
+        if (near == NO_TRIANGLE) {
+            sp_meshlet_flush(ctx);
+            near = nearest_free(ctx, &s, point, 0);
+        }
+        emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
+    }
+    sp_meshlet_flush(ctx);
+}
