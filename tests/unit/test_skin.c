@@ -163,8 +163,19 @@ static void bad_input_names_the_vertex(void)
     free(scratch);
 }
 
+static void summary_of_errors(void)
+{
+    const float errors[4] = {0, 0.25f, 0.5f, 1.0f};
+    sp_error_stats s;
+    sp_summarize_errors(errors, 4, 0.5, &s);
+    CHECK(s.max_error == 1.0 && s.worst_vertex == 3 && s.vertices_over_bound == 1 && s.histogram_max == 1.0);
+    CHECK(fabs(s.mean_error - 0.4375) < 1e-12 && fabs(s.rms_error - sqrt(1.3125 / 4)) < 1e-12);
+    CHECK(s.histogram[0] == 1 && s.histogram[4] == 1 && s.histogram[8] == 1 && s.histogram[15] == 1);
+}
+
 int main(void)
 {
+    summary_of_errors();
     make_skin();
     budgets();
     corrupt_data_is_rejected();
