@@ -36,12 +36,16 @@ static inline __attribute__((always_inline)) void sp_grid_quantize(const float* 
             deficit -= f;
         }
         if (deficit >= 0 && deficit < (int64_t)k) {
-            for (uint32_t i = 0; i < k; ++i) {
-                int64_t rank = 0; /* components that win the bump before i: larger, or equal and lower */
-                for (uint32_t j = 0; j < k; ++j)
-                    rank += (remainder[j] > remainder[i]) | ((remainder[j] == remainder[i]) & (j < i));
-                q[i] += (uint64_t)(rank < deficit);
-            }
+            /* rank[i]: components that win the bump before i (larger, or equal and lower);
+             * each pair is compared once, a < b wins when its remainder is not smaller. */
+            int64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+            for (uint32_t a = 0; a < k; ++a)
+                for (uint32_t b = a + 1; b < k; ++b) {
+                    int64_t a_wins = remainder[a] >= remainder[b];
+                    rank[b] += a_wins;
+                    rank[a] += 1 - a_wins;
+                }
+            for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
             return;
         }
     }

@@ -15,11 +15,21 @@
 /* Below this N every closed form fits in 64 bits (u(k) < 3N^3), so the fast path is exact. */
 #define OSS_SMALL_N ((uint64_t)1 << 20)
 
+/* 64-bit forms for N < OSS_SMALL_N, inlined into the encode and decode paths. */
+static inline uint64_t row_base_small(uint64_t n, uint64_t j)
+{
+    return (4 * j * n + 2 * j + 1 - 3 * j * j) / 4;
+}
+
+static inline uint64_t layer_base_small(uint64_t n, uint64_t k)
+{
+    return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9;
+}
+
 uint64_t sp_oss_row_base(uint64_t n, uint64_t j)
 {
     /* floor((-3j^2 + 2j + 4jN + 1) / 4); the numerator is positive for rows inside the triangle. */
-    if (n < OSS_SMALL_N && j < OSS_SMALL_N)
-        return (4 * j * n + 2 * j + 1 - 3 * j * j) / 4;
+    if (n < OSS_SMALL_N && j < OSS_SMALL_N) return row_base_small(n, j);
     sp_u128 jj = j, nn = n;
     return (uint64_t)((4 * jj * nn + 2 * jj + 1 - 3 * jj * jj) / 4);
 }
@@ -33,8 +43,7 @@ uint64_t sp_oss_triangle_count(uint64_t n)
 uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
-    if (n < OSS_SMALL_N)
-        return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9;
+    if (n < OSS_SMALL_N) return layer_base_small(n, k);
     sp_u128 nn = n, kk = k;
     return (uint64_t)((3 * nn * kk * (nn - 2 * kk + 3) + kk * (4 * kk * kk - 9 * kk + 6) + 2) / 9);
 }
@@ -62,6 +71,10 @@ sp_u128 sp_oss_code_count(uint64_t n, uint32_t k)
 
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 {
+    if (n < OSS_SMALL_N && k == 4) {
+        uint64_t layer = q[3];
+        return layer_base_small(n, layer) + row_base_small(n - 2 * layer, q[2] - q[3]) + (q[1] - q[2]);
+    }
     switch (k) {
     case 2: return q[1];
     case 3: return sp_oss_row_base(n, q[2]) + (q[1] - q[2]);
@@ -93,6 +106,11 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w)
     double estimate = (apex - sqrt(mirrored)) / 3.0;
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
+    if (n < OSS_SMALL_N) {
+        while (j + 1 < rows && row_base_small(n, j + 1) <= w) ++j;
+        while (j > 0 && row_base_small(n, j) > w) --j;
+        return j;
+    }
     while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
     while (j > 0 && sp_oss_row_base(n, j) > w) --j;
     return j;
@@ -131,6 +149,11 @@ static uint64_t oss_find_layer(uint64_t n, uint64_t code)
     double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
     uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (k >= layers) k = layers - 1;
+    if (n < OSS_SMALL_N) {
+        while (k + 1 < layers && layer_base_small(n, k + 1) <= code) ++k;
+        while (k > 0 && layer_base_small(n, k) > code) --k;
+        return k;
+    }
     while (k + 1 < layers && sp_oss_layer_base(n, k + 1) <= code) ++k;
     while (k > 0 && sp_oss_layer_base(n, k) > code) --k;
     return k;
@@ -146,7 +169,7 @@ void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
     }
     if (k == 4) {
         layer = oss_find_layer(n, code);
-        rest -= sp_oss_layer_base(n, layer);
+        rest -= sp_oss_layer_base(n, layer); /* inlined small form for small N */
         bottom = n - 2 * layer;
     }
     row = oss_find_row(bottom, rest);
