@@ -1,5 +1,6 @@
 /* Whole-skin compression: budgets, round trip within bound, corrupt-data detection. */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -163,6 +164,29 @@ static void bad_input_names_the_vertex(void)
     free(scratch);
 }
 
+/* No global state: concurrent compressions give the single-threaded result bit for bit. */
+static void *compress_in_thread(void* out)
+{
+    sp_compress_options o;
+    sp_compress_options_default(&o);
+    return compress(&o, (compressed*)out) == SP_OK ? out : NULL;
+}
+
+static void threads_agree(void)
+{
+    static compressed reference, results[4];
+    pthread_t threads[4];
+    CHECK(compress_in_thread(&reference) != NULL);
+    for (int i = 0; i < 4; ++i) CHECK(pthread_create(&threads[i], NULL, compress_in_thread, &results[i]) == 0);
+    for (int i = 0; i < 4; ++i) {
+        void* ok = NULL;
+        CHECK(pthread_join(threads[i], &ok) == 0 && ok != NULL);
+        CHECK(memcmp(results[i].words, reference.words, sizeof(reference.words)) == 0);
+        CHECK(memcmp(results[i].lut, reference.lut, sizeof(reference.lut)) == 0);
+        CHECK(results[i].info.lut_size == reference.info.lut_size);
+    }
+}
+
 static void summary_of_errors(void)
 {
     const float errors[4] = {0, 0.25f, 0.5f, 1.0f};
@@ -177,6 +201,7 @@ int main(void)
 {
     summary_of_errors();
     make_skin();
+    threads_agree();
     budgets();
     corrupt_data_is_rejected();
     bad_input_names_the_vertex();
