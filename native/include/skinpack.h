@@ -316,7 +316,7 @@ typedef struct sp_meshlet_options {
     uint32_t max_triangles;       /* 1..512, default 124 */
     uint32_t max_joints;          /* palette limit 1..255, default 32; every builder respects it */
     uint32_t min_group_triangles; /* SP_MESHLETS_COMMON: smaller groups go to the remainder; default 16 */
-    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices; default 1 */
+    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 1 */
 } sp_meshlet_options;
 
 /* Fills the defaults listed above. */
@@ -330,6 +330,8 @@ SP_API void sp_meshlet_options_default(sp_meshlet_options* options);
  *   tuples[K * tuple_offset + K * u + s]                            (u < tuple_count, s < K)
  * Vertex i's joint in weight slot s is joints[joint_offset + tuples[K * (tuple_offset +
  * vertex_tuples[vertex_offset + i]) + s]]; slots whose weight is zero hold palette index 0.
+ * Palettes and LUTs list entries in order of first use along the vertex list. Arrays are packed
+ * in meshlet order. Meshlet of source triangle t: see sp_meshlet_buffers.triangle_meshlet.
  */
 typedef struct sp_meshlet {
     uint32_t vertex_offset;   /* first entry in vertices[] and vertex_tuples[] */

@@ -148,14 +148,6 @@ static size_t count_global_tuples(const sp_meshlet_context* ctx, uint64_t* set)
     return unique;
 }
 
-static uint32_t bits_for(size_t count)
-{
-    uint32_t bits = 0;
-    while (bits < 64 && ((uint64_t)1 << bits) < count)
-        ++bits;
-    return bits;
-}
-
 static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)
 {
     const sp_meshlet* meshlets = ctx->out->meshlets;
@@ -186,7 +178,7 @@ static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)
     if (ctx->used.vertices)
         stats->local_tuple_bits_mean = local_bits / ctx->used.vertices;
     stats->global_tuples = count_global_tuples(ctx, (uint64_t*)ctx->builder_scratch);
-    stats->global_tuple_bits = bits_for(stats->global_tuples);
+    stats->global_tuple_bits = sp_index_bits(stats->global_tuples);
 }
 
 static sp_result check_indices(const uint32_t* indices, size_t index_count, size_t vertex_count, size_t* error_triangle)

@@ -188,14 +188,6 @@ static void compute_cone(const sp_meshlet_context* ctx, sp_meshlet* m)
 
 /* ---- writing a meshlet ----------------------------------------------------------------- */
 
-static uint32_t index_bits(uint32_t count)
-{
-    uint32_t bits = 0;
-    while (bits < 32 && (1u << bits) < count)
-        ++bits;
-    return bits;
-}
-
 /* Local tuple LUT: each vertex's joints as palette indices (zero-weight slots: 0), unique
  * entries in order of first use. A meshlet has at most 255 vertices, so a linear search over
  * its own tuples (packed into one u32 each, K <= 4) is cheap and needs no scratch. */
@@ -224,7 +216,7 @@ static void write_local_tuples(sp_meshlet_context* ctx, sp_meshlet* m)
     }
     m->tuple_offset = (uint32_t)ctx->used.tuples;
     m->tuple_count = (uint16_t)count;
-    m->tuple_bits = index_bits(count);
+    m->tuple_bits = sp_index_bits(count);
     ctx->used.tuples += count;
 }
 

@@ -4,12 +4,13 @@
  * Grows one meshlet at a time like meshopt_buildMeshlets: the next triangle is the best live
  * triangle adjacent to the meshlet's vertices; when the meshlet's surface patch runs out, the
  * nearest free triangle (searched in a widening window of the Morton order of triangle
- * centroids, where meshopt uses a k-d tree) continues it. The score adds skinning to meshoptimizer's: a candidate costs its new vertices
- * (0 if it adds none, 1 if it completes a vertex's fan) plus joint_cost per joint it would add
- * to the palette, so a meshlet fills up inside one region of the skeleton before it crosses into
- * the next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet is closed when
- * no adjacent triangle fits a limit, and the next one starts from the best of those misfits, so
- * consecutive meshlets stay neighbours and leave no scattered leftovers behind.
+ * centroids, where meshoptimizer uses a k-d tree) continues it. The score adds skinning to
+ * meshoptimizer's: a candidate costs its topological priority (0 if it adds no vertex, 1 if it
+ * completes a vertex's fan, else new vertices + 1) plus joint_cost per joint it would add to the
+ * palette, so a meshlet fills up inside one region of the skeleton before it crosses into the
+ * next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet
+ * is closed when no adjacent triangle fits a limit, and the next one starts from the best of
+ * those misfits, so consecutive meshlets stay neighbours and leave no scattered leftovers.
  */
 #include "meshlets_internal.h"
 

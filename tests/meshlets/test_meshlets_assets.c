@@ -1,0 +1,88 @@
+/*
+ * test_meshlets_assets.c - every builder at several limits on real skinned meshes exported by
+ * export_mesh_data.py (label "meshlets"): the full meshlet_check on each output, determinism of
+ * each builder (at 64/124/32), and the palette-limit error on a limit below the mesh's widest
+ * triangle.
+ *
+ *   test_meshlets_assets FILE.spmd...
+ */
+#include "mesh_data.h"
+#include "meshlet_check.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char* builder_names[SP_MESHLETS_BUILDER_COUNT] = {"naive", "common", "skin"};
+
+static int check_file(const char* path)
+{
+    mesh_data mesh;
+    if (!mesh_data_load(path, 4, &mesh))
+        return 1;
+    printf("%s: %zu vertices, %zu triangles, %zu joints, %zu vertices without weights bound to joint 0\n", path,
+           mesh.vertex_count, mesh.index_count / 3, mesh.joint_count, mesh.unweighted_vertices);
+    meshlet_input in = {mesh.indices, mesh.index_count, mesh.positions, mesh.vertex_count, mesh.joints, mesh.weights,
+                        mesh.influences};
+    const uint32_t limits[][3] = {{64, 124, 32}, {64, 124, 16}, {32, 64, 12}, {128, 256, 48}, {255, 512, 255}};
+    int failures = 0;
+    for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
+        for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l) {
+            sp_meshlet_options o;
+            sp_meshlet_options_default(&o);
+            o.builder = b;
+            o.max_vertices = limits[l][0];
+            o.max_triangles = limits[l][1];
+            o.max_joints = limits[l][2];
+            meshlet_run run, again;
+            meshlet_run_build(&run, &in, &o);
+            char message[256] = "";
+            int ok = meshlet_check(&run, &in, &o, message, sizeof(message));
+            int same = 1;
+            if (l == 0) { /* determinism: once per builder, at the default limits */
+                meshlet_run_build(&again, &in, &o);
+                same = meshlet_runs_equal(&run, &again, in.influences, in.index_count / 3);
+                meshlet_run_free(&again);
+            }
+            printf("%s %-6s %3u/%3u/%3u: %s%s %zu meshlets, joints mean %.2f max %u, tuple bits %.2f local / %u global\n",
+                   path, builder_names[b], o.max_vertices, o.max_triangles, o.max_joints, ok ? "ok" : message,
+                   same ? "" : " NOT DETERMINISTIC", run.stats.meshlet_count, run.stats.mean_joints,
+                   run.stats.max_joints, run.stats.local_tuple_bits_mean, run.stats.global_tuple_bits);
+            failures += !ok + !same;
+            meshlet_run_free(&run);
+        }
+
+    /* the widest triangle: build one meshlet per triangle and take the largest palette */
+    sp_meshlet_options single;
+    sp_meshlet_options_default(&single);
+    single.builder = SP_MESHLETS_NAIVE;
+    single.max_triangles = 1;
+    single.max_joints = SP_MESHLET_MAX_JOINTS;
+    meshlet_run run;
+    meshlet_run_build(&run, &in, &single);
+    uint32_t widest = run.stats.max_joints;
+    meshlet_run_free(&run);
+    if (widest > 1) {
+        single.max_joints = widest - 1;
+        single.builder = SP_MESHLETS_SKIN;
+        meshlet_run_build(&run, &in, &single);
+        int named = run.result == SP_ERR_LIMIT_EXCEEDED && run.stats.error_triangle < in.index_count / 3;
+        printf("%s palette limit %u below the widest triangle (%u joints): %s, triangle %zu\n", path, widest - 1, widest,
+               sp_result_string(run.result), run.stats.error_triangle);
+        failures += !named;
+        meshlet_run_free(&run);
+    }
+    mesh_data_free(&mesh);
+    return failures;
+}
+
+int main(int argc, char** argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_meshlets_assets FILE.spmd...\n");
+        return 2;
+    }
+    int failures = 0;
+    for (int i = 1; i < argc; ++i)
+        failures += check_file(argv[i]);
+    return failures ? 1 : 0;
+}

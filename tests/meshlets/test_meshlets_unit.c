@@ -1,0 +1,476 @@
+/*
+ * test_meshlets_unit.c - sp_build_meshlets on synthetic meshes (label "unit": no assets, also
+ * run under ASan/UBSan): every builder's output is checked in full by meshlet_check, plus the
+ * thesis baselines' defining behaviour, determinism, the palette-limit error and bad arguments.
+ */
+#include "meshlet_check.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+
+#define EXPECT(cond, ...)                                                   \
+    do {                                                                    \
+        if (!(cond)) {                                                      \
+            fprintf(stderr, "%s:%d: %s: ", __FILE__, __LINE__, #cond);      \
+            fprintf(stderr, __VA_ARGS__);                                   \
+            fprintf(stderr, "\n");                                          \
+            failures++;                                                     \
+        }                                                                   \
+    } while (0)
+
+/* ---- synthetic skinned grid ------------------------------------------------------------- */
+
+enum { K = 4 };
+
+typedef struct mesh {
+    size_t vertex_count, index_count;
+    float* positions;
+    uint32_t* indices;
+    uint16_t* joints;
+    float* weights;
+} mesh;
+
+static meshlet_input input_of(const mesh* m)
+{
+    meshlet_input in = {m->indices, m->index_count, m->positions, m->vertex_count, m->joints, m->weights, K};
+    return in;
+}
+
+/* Sorts one vertex's K influences by descending weight and normalises them, as
+ * sp_prepare_influences would (kept local so these tests do not depend on it). */
+static void sort_influences(uint16_t* j, float* w)
+{
+    float sum = 0.0f;
+    for (int a = 0; a < K; ++a)
+        sum += w[a];
+    for (int a = 0; a < K; ++a) {
+        w[a] /= sum;
+        for (int b = a; b > 0 && (w[b] > w[b - 1] || (w[b] == w[b - 1] && j[b] < j[b - 1])); --b) {
+            float tw = w[b]; w[b] = w[b - 1]; w[b - 1] = tw;
+            uint16_t tj = j[b]; j[b] = j[b - 1]; j[b - 1] = tj;
+        }
+    }
+}
+
+/* side x side vertices on a slightly bumpy plane; 16 joints on a 4x4 lattice; each vertex is
+ * weighted to the joints within reach (up to 4), so joint sets change across the surface like
+ * on a character: plateaus of one joint and blended seams. */
+static mesh make_grid(int side)
+{
+    mesh m;
+    m.vertex_count = (size_t)side * side;
+    m.index_count = (size_t)(side - 1) * (side - 1) * 6;
+    m.positions = malloc(m.vertex_count * 3 * sizeof(float));
+    m.indices = malloc(m.index_count * sizeof(uint32_t));
+    m.joints = malloc(m.vertex_count * K * sizeof(uint16_t));
+    m.weights = malloc(m.vertex_count * K * sizeof(float));
+    for (int y = 0; y < side; ++y)
+        for (int x = 0; x < side; ++x) {
+            size_t v = (size_t)y * side + x;
+            float px = (float)x / (side - 1), py = (float)y / (side - 1);
+            m.positions[v * 3 + 0] = px;
+            m.positions[v * 3 + 1] = py;
+            m.positions[v * 3 + 2] = 0.05f * sinf(px * 9.0f) * cosf(py * 7.0f);
+            uint16_t* j = m.joints + v * K;
+            float* w = m.weights + v * K;
+            int n = 0;
+            for (int joint = 0; joint < 16 && n < K; ++joint) {
+                float cx = (joint % 4 + 0.5f) / 4.0f, cy = (joint / 4 + 0.5f) / 4.0f;
+                float d = fmaxf(fabsf(px - cx), fabsf(py - cy));
+                if (d < 0.16f) {
+                    j[n] = (uint16_t)joint;
+                    w[n++] = 0.16f - d;
+                }
+            }
+            if (n == 0) { /* between lattice cells: nearest joint */
+                j[n] = (uint16_t)((int)(py * 4 > 3 ? 3 : py * 4) * 4 + (int)(px * 4 > 3 ? 3 : px * 4));
+                w[n++] = 1.0f;
+            }
+            for (; n < K; ++n) {
+                j[n] = 0;
+                w[n] = 0.0f;
+            }
+            sort_influences(j, w);
+        }
+    size_t i = 0;
+    for (int y = 0; y + 1 < side; ++y)
+        for (int x = 0; x + 1 < side; ++x) {
+            uint32_t a = (uint32_t)(y * side + x), b = a + 1, c = a + (uint32_t)side, d = c + 1;
+            uint32_t quad[6] = {a, b, d, a, d, c};
+            memcpy(m.indices + i, quad, sizeof(quad));
+            i += 6;
+        }
+    return m;
+}
+
+static void free_mesh(mesh* m)
+{
+    free(m->positions);
+    free(m->indices);
+    free(m->joints);
+    free(m->weights);
+}
+
+static uint32_t next_random(uint32_t* state)
+{
+    *state = *state * 1664525u + 1013904223u;
+    return *state >> 8;
+}
+
+/* Same surface with shuffled triangles, rotated corners and permuted vertices. */
+static mesh shuffled_copy(const mesh* src, uint32_t seed)
+{
+    mesh m = *src;
+    m.positions = malloc(m.vertex_count * 3 * sizeof(float));
+    m.indices = malloc(m.index_count * sizeof(uint32_t));
+    m.joints = malloc(m.vertex_count * K * sizeof(uint16_t));
+    m.weights = malloc(m.vertex_count * K * sizeof(float));
+    uint32_t* to_new = malloc(m.vertex_count * sizeof(uint32_t));
+    for (size_t v = 0; v < m.vertex_count; ++v)
+        to_new[v] = (uint32_t)v;
+    for (size_t v = m.vertex_count; v > 1; --v) {
+        size_t r = next_random(&seed) % v;
+        uint32_t t = to_new[v - 1]; to_new[v - 1] = to_new[r]; to_new[r] = t;
+    }
+    for (size_t v = 0; v < m.vertex_count; ++v) {
+        memcpy(m.positions + to_new[v] * 3, src->positions + v * 3, 3 * sizeof(float));
+        memcpy(m.joints + to_new[v] * K, src->joints + v * K, K * sizeof(uint16_t));
+        memcpy(m.weights + to_new[v] * K, src->weights + v * K, K * sizeof(float));
+    }
+    size_t triangles = m.index_count / 3;
+    uint32_t* order = malloc(triangles * sizeof(uint32_t));
+    for (size_t t = 0; t < triangles; ++t)
+        order[t] = (uint32_t)t;
+    for (size_t t = triangles; t > 1; --t) {
+        size_t r = next_random(&seed) % t;
+        uint32_t s = order[t - 1]; order[t - 1] = order[r]; order[r] = s;
+    }
+    for (size_t t = 0; t < triangles; ++t) {
+        int rot = (int)(next_random(&seed) % 3);
+        for (int c = 0; c < 3; ++c)
+            m.indices[t * 3 + c] = to_new[src->indices[order[t] * 3 + (c + rot) % 3]];
+    }
+    free(order);
+    free(to_new);
+    return m;
+}
+
+static sp_meshlet_options options_for(uint32_t builder, uint32_t max_vertices, uint32_t max_triangles, uint32_t max_joints)
+{
+    sp_meshlet_options o;
+    sp_meshlet_options_default(&o);
+    o.builder = builder;
+    o.max_vertices = max_vertices;
+    o.max_triangles = max_triangles;
+    o.max_joints = max_joints;
+    return o;
+}
+
+static const char* builder_name(uint32_t b)
+{
+    return b == SP_MESHLETS_NAIVE ? "naive" : b == SP_MESHLETS_COMMON ? "common" : "skin";
+}
+
+/* Builds, checks everything, and checks that a second run is byte-identical. */
+static sp_meshlet_stats build_and_check(const mesh* m, const sp_meshlet_options* o, const char* what)
+{
+    meshlet_input in = input_of(m);
+    meshlet_run first, second;
+    meshlet_run_build(&first, &in, o);
+    meshlet_run_build(&second, &in, o);
+    char message[256];
+    int ok = meshlet_check(&first, &in, o, message, sizeof(message));
+    EXPECT(ok, "%s, %s %u/%u/%u: %s", what, builder_name(o->builder), o->max_vertices, o->max_triangles,
+           o->max_joints, message);
+    EXPECT(meshlet_runs_equal(&first, &second, K, m->index_count / 3), "%s, %s: two runs differ", what,
+           builder_name(o->builder));
+    sp_meshlet_stats stats = first.stats;
+    meshlet_run_free(&first);
+    meshlet_run_free(&second);
+    return stats;
+}
+
+/* ---- tests ------------------------------------------------------------------------------ */
+
+static void test_every_builder_and_limit(void)
+{
+    mesh grid = make_grid(48);
+    mesh shuffled = shuffled_copy(&grid, 7);
+    const uint32_t limits[][3] = {{64, 124, 32}, {64, 124, 12}, {255, 512, 255}, {32, 64, 16}, {3, 1, 12}, {128, 256, 24}};
+    for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
+        for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l) {
+            sp_meshlet_options o = options_for(b, limits[l][0], limits[l][1], limits[l][2]);
+            sp_meshlet_stats s = build_and_check(&grid, &o, "grid");
+            build_and_check(&shuffled, &o, "shuffled grid");
+            if (o.max_triangles == 1)
+                EXPECT(s.meshlet_count == grid.index_count / 3, "one triangle per meshlet: %zu", s.meshlet_count);
+        }
+    free_mesh(&shuffled);
+    free_mesh(&grid);
+}
+
+static void test_bound(void)
+{
+    sp_meshlet_sizes s;
+    sp_meshlets_bound(300, 50, 4, NULL, &s);
+    EXPECT(s.meshlets == 100 && s.vertices == 300 && s.triangles == 100 && s.joints == 1200 && s.tuples == 300,
+           "bound %zu %zu %zu %zu %zu", s.meshlets, s.vertices, s.triangles, s.joints, s.tuples);
+    EXPECT(s.scratch_bytes >= 65536 + 50, "scratch %zu", s.scratch_bytes);
+}
+
+/* Listing A.1: triangles in index order; a meshlet closes on the first one that does not fit. */
+static void test_naive_is_index_order(void)
+{
+    mesh grid = make_grid(20);
+    sp_meshlet_options o = options_for(SP_MESHLETS_NAIVE, 64, 124, 255);
+    meshlet_input in = input_of(&grid);
+    meshlet_run run;
+    meshlet_run_build(&run, &in, &o);
+    for (size_t t = 1; t < grid.index_count / 3; ++t)
+        EXPECT(run.out.triangle_meshlet[t] >= run.out.triangle_meshlet[t - 1], "triangle %zu goes back", t);
+    /* a meshlet was closed only because its next triangle would exceed 64 vertices */
+    for (size_t i = 0; i + 1 < run.stats.meshlet_count; ++i) {
+        const sp_meshlet* m = &run.out.meshlets[i];
+        EXPECT(m->vertex_count > 61 || m->triangle_count == 124, "meshlet %zu closed early: %u vertices", i,
+               m->vertex_count);
+    }
+    /* two triangles sharing an edge need four vertices */
+    const uint32_t pair[6] = {0, 1, 2, 2, 1, 3};
+    meshlet_input two = {pair, 6, grid.positions, 4, grid.joints, grid.weights, K};
+    meshlet_run small;
+    o.max_vertices = 3;
+    meshlet_run_build(&small, &two, &o);
+    EXPECT(small.result == SP_OK && small.stats.meshlet_count == 2, "3 vertices: %zu", small.stats.meshlet_count);
+    meshlet_run_free(&small);
+    o.max_vertices = 4;
+    meshlet_run_build(&small, &two, &o);
+    EXPECT(small.result == SP_OK && small.stats.meshlet_count == 1, "4 vertices: %zu", small.stats.meshlet_count);
+    meshlet_run_free(&small);
+    meshlet_run_free(&run);
+    free_mesh(&grid);
+}
+
+/* Listing A.2: same-joint-set groups get meshlets of their own; mixed triangles and small
+ * groups share the remainder meshlets, which come last. */
+static void test_common_influences_groups(void)
+{
+    mesh grid = make_grid(40);
+    meshlet_input in = input_of(&grid);
+    sp_meshlet_options o = options_for(SP_MESHLETS_COMMON, 64, 124, 32);
+    o.min_group_triangles = 1;
+    meshlet_run run;
+    meshlet_run_build(&run, &in, &o);
+    size_t triangles = grid.index_count / 3, mixed = 0;
+    uint32_t first_remainder = UINT32_MAX;
+    for (size_t t = 0; t < triangles; ++t) {
+        /* a triangle is pure when its three vertices have identical joint lists */
+        const uint32_t* v = grid.indices + t * 3;
+        int pure = memcmp(grid.joints + v[0] * K, grid.joints + v[1] * K, K * 2) == 0 &&
+                   memcmp(grid.joints + v[0] * K, grid.joints + v[2] * K, K * 2) == 0;
+        if (!pure) {
+            mixed++;
+            first_remainder = run.out.triangle_meshlet[t] < first_remainder ? run.out.triangle_meshlet[t] : first_remainder;
+        }
+    }
+    EXPECT(mixed > 0 && mixed < triangles, "the grid needs both kinds: %zu mixed", mixed);
+    for (size_t t = 0; t < triangles; ++t) {
+        uint32_t id = run.out.triangle_meshlet[t];
+        if (id < first_remainder)
+            EXPECT(run.out.meshlets[id].joint_count <= K, "group meshlet %u has %u joints", id,
+                   run.out.meshlets[id].joint_count);
+    }
+    sp_meshlet_options naive = options_for(SP_MESHLETS_NAIVE, 64, 124, 32);
+    meshlet_run baseline;
+    meshlet_run_build(&baseline, &in, &naive);
+    EXPECT(run.stats.meshlet_count > baseline.stats.meshlet_count, "grouping should cost meshlets: %zu vs %zu",
+           run.stats.meshlet_count, baseline.stats.meshlet_count);
+    EXPECT(run.stats.mean_joints < baseline.stats.mean_joints, "grouping should shrink palettes");
+    meshlet_run_free(&baseline);
+    meshlet_run_free(&run);
+
+    /* with every group too small, everything is remainder: the naive walk in index order */
+    o.min_group_triangles = 1u << 30;
+    meshlet_run_build(&run, &in, &o);
+    meshlet_run_build(&baseline, &in, &naive);
+    EXPECT(meshlet_runs_equal(&run, &baseline, K, triangles), "all-remainder common != naive");
+    meshlet_run_free(&baseline);
+    meshlet_run_free(&run);
+    free_mesh(&grid);
+}
+
+/* Ours must keep palettes smaller than the naive walk while staying close in count. */
+static void test_skin_builder_quality(void)
+{
+    mesh grid = make_grid(64);
+    sp_meshlet_options naive = options_for(SP_MESHLETS_NAIVE, 64, 124, 32);
+    sp_meshlet_options skin = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_stats n = build_and_check(&grid, &naive, "quality");
+    sp_meshlet_stats s = build_and_check(&grid, &skin, "quality");
+    EXPECT(s.mean_joints < n.mean_joints, "skin %.2f joints vs naive %.2f", s.mean_joints, n.mean_joints);
+    EXPECT(s.local_tuple_bits_mean < s.global_tuple_bits, "local %.2f bits vs global %u", s.local_tuple_bits_mean,
+           s.global_tuple_bits);
+    EXPECT(s.meshlet_count <= n.meshlet_count * 12 / 10, "skin %zu meshlets vs naive %zu", s.meshlet_count,
+           n.meshlet_count);
+    free_mesh(&grid);
+}
+
+static void test_degenerate_triangles(void)
+{
+    mesh grid = make_grid(12);
+    grid.indices[4] = grid.indices[3];                    /* triangle 1: a, a, c */
+    grid.indices[9] = grid.indices[10] = grid.indices[11]; /* triangle 3: a point */
+    for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b) {
+        sp_meshlet_options o = options_for(b, 3, 124, 16);
+        build_and_check(&grid, &o, "degenerate");
+        o.max_vertices = 64;
+        build_and_check(&grid, &o, "degenerate");
+    }
+    free_mesh(&grid);
+}
+
+/* Three vertices with four joints each, all different: the triangle needs 12 palette slots. */
+static void test_palette_limit_error(void)
+{
+    const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    const uint32_t indices[] = {0, 1, 3, 0, 1, 2};
+    uint16_t joints[4 * K];
+    float weights[4 * K];
+    for (int v = 0; v < 4; ++v)
+        for (int s = 0; s < K; ++s) {
+            joints[v * K + s] = (uint16_t)(v * K + s);
+            weights[v * K + s] = 0.4f - 0.1f * s;
+        }
+    joints[3 * K] = 0; /* vertex 3 shares a joint: triangle 0 needs 11 */
+    meshlet_input in = {indices, 6, positions, 4, joints, weights, K};
+    for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b) {
+        sp_meshlet_options o = options_for(b, 64, 124, 11);
+        meshlet_run run;
+        meshlet_run_build(&run, &in, &o);
+        EXPECT(run.result == SP_ERR_LIMIT_EXCEEDED && run.stats.error_triangle == 1, "%s: %s, triangle %zu",
+               builder_name(b), sp_result_string(run.result), run.stats.error_triangle);
+        meshlet_run_free(&run);
+        o.max_joints = 12;
+        meshlet_run_build(&run, &in, &o);
+        char message[256];
+        EXPECT(meshlet_check(&run, &in, &o, message, sizeof(message)), "%s: %s", builder_name(b), message);
+        EXPECT(run.stats.max_joints <= 12, "%u joints", run.stats.max_joints);
+        meshlet_run_free(&run);
+    }
+}
+
+static sp_result build_with(const mesh* m, const uint32_t* indices, size_t index_count, size_t stride, size_t k,
+                            const sp_meshlet_options* o, meshlet_run* run, int shrink)
+{
+    /* a run sized for the real input, then one call with the arguments under test */
+    meshlet_input in = input_of(m);
+    meshlet_run_build(run, &in, o);
+    sp_meshlet_buffers out = run->out;
+    size_t scratch_size = run->scratch_size;
+    if (shrink == 1) out.capacity.meshlets--;
+    if (shrink == 2) out.capacity.vertices--;
+    if (shrink == 3) out.capacity.triangles--;
+    if (shrink == 4) out.capacity.joints--;
+    if (shrink == 5) out.capacity.tuples--;
+    if (shrink == 6) scratch_size--;
+    return sp_build_meshlets(indices, index_count, m->positions, m->vertex_count, stride, m->joints, m->weights, k, o,
+                             &out, run->scratch, scratch_size, &run->stats);
+}
+
+static void test_invalid_arguments(void)
+{
+    mesh grid = make_grid(8);
+    sp_meshlet_options good = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    meshlet_run run;
+    for (int shrink = 1; shrink <= 6; ++shrink) {
+        sp_result r = build_with(&grid, grid.indices, grid.index_count, 12, K, &good, &run, shrink);
+        EXPECT(r == SP_ERR_BUFFER_TOO_SMALL, "shrink %d: %s", shrink, sp_result_string(r));
+        meshlet_run_free(&run);
+    }
+    const sp_meshlet_options bad[] = {
+        options_for(SP_MESHLETS_BUILDER_COUNT, 64, 124, 32), options_for(SP_MESHLETS_SKIN, 2, 124, 32),
+        options_for(SP_MESHLETS_SKIN, 256, 124, 32),         options_for(SP_MESHLETS_SKIN, 64, 0, 32),
+        options_for(SP_MESHLETS_SKIN, 64, 513, 32),          options_for(SP_MESHLETS_SKIN, 64, 124, 0),
+        options_for(SP_MESHLETS_SKIN, 64, 124, 256)};
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
+        sp_result r = build_with(&grid, grid.indices, grid.index_count, 12, K, &bad[i], &run, 0);
+        EXPECT(r == SP_ERR_INVALID_ARGUMENT, "bad options %zu: %s", i, sp_result_string(r));
+        meshlet_run_free(&run);
+    }
+    sp_meshlet_options negative = good;
+    negative.joint_cost = -1.0f;
+    EXPECT(build_with(&grid, grid.indices, grid.index_count, 12, K, &negative, &run, 0) == SP_ERR_INVALID_ARGUMENT,
+           "negative joint cost");
+    meshlet_run_free(&run);
+    EXPECT(build_with(&grid, grid.indices, grid.index_count - 1, 12, K, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT,
+           "index count not a multiple of 3");
+    meshlet_run_free(&run);
+    EXPECT(build_with(&grid, grid.indices, 0, 12, K, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT, "no triangles");
+    meshlet_run_free(&run);
+    EXPECT(build_with(&grid, grid.indices, grid.index_count, 10, K, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT,
+           "stride 10");
+    meshlet_run_free(&run);
+    EXPECT(build_with(&grid, grid.indices, grid.index_count, 12, 5, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT,
+           "K = 5");
+    meshlet_run_free(&run);
+    uint32_t* broken = malloc(grid.index_count * sizeof(uint32_t));
+    memcpy(broken, grid.indices, grid.index_count * sizeof(uint32_t));
+    broken[13] = (uint32_t)grid.vertex_count;
+    EXPECT(build_with(&grid, broken, grid.index_count, 12, K, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT &&
+               run.stats.error_triangle == 4,
+           "index out of range: triangle %zu", run.stats.error_triangle);
+    meshlet_run_free(&run);
+    free(broken);
+    EXPECT(sp_build_meshlets(NULL, 3, grid.positions, 3, 12, grid.joints, grid.weights, K, NULL, NULL, NULL, 0, NULL) ==
+               SP_ERR_INVALID_ARGUMENT,
+           "null pointers");
+    free_mesh(&grid);
+}
+
+/* The checker itself must fail on broken output, or every other test here proves nothing. */
+static void test_checker_catches_corruption(void)
+{
+    mesh grid = make_grid(24);
+    meshlet_input in = input_of(&grid);
+    sp_meshlet_options o = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    char message[256];
+    for (int corruption = 0; corruption < 7; ++corruption) {
+        meshlet_run run;
+        meshlet_run_build(&run, &in, &o);
+        sp_meshlet* m = &run.out.meshlets[1];
+        switch (corruption) {
+        case 0: run.out.triangles[m->triangle_offset * 3] = run.out.triangles[m->triangle_offset * 3 + 1]; break;
+        case 1: run.out.joints[m->joint_offset] ^= 1; break;
+        case 2: run.out.tuples[m->tuple_offset * K] ^= 1; break;
+        case 3: m->radius *= 0.5f; break;
+        case 4: m->triangle_count = (uint16_t)(o.max_triangles + 1); break;
+        case 5: run.out.vertices[m->vertex_offset] = run.out.vertices[m->vertex_offset + 1]; break;
+        case 6: run.out.triangle_meshlet[0] ^= 1; break;
+        }
+        EXPECT(!meshlet_check(&run, &in, &o, message, sizeof(message)), "corruption %d went unnoticed", corruption);
+        meshlet_run_free(&run);
+    }
+    free_mesh(&grid);
+}
+
+int main(void)
+{
+    test_checker_catches_corruption();
+    test_bound();
+    test_every_builder_and_limit();
+    test_naive_is_index_order();
+    test_common_influences_groups();
+    test_skin_builder_quality();
+    test_degenerate_triangles();
+    test_palette_limit_error();
+    test_invalid_arguments();
+    if (failures) {
+        fprintf(stderr, "test_meshlets_unit: %d failures\n", failures);
+        return 1;
+    }
+    printf("test_meshlets_unit: ok\n");
+    return 0;
+}
