@@ -1,0 +1,132 @@
+"""The "Skinpack" panel in Properties > Object Data of a mesh deformed by an armature."""
+
+import bpy
+
+from . import gather, native, preview, storage
+
+
+class SKINPACK_PT_skin(bpy.types.Panel):
+    bl_label = "Skinpack"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "data"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.object
+        return obj is not None and obj.type == 'MESH' and gather.find_armature(obj) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.object
+        mesh = obj.data
+        if native.load() is None:
+            box = layout.box()
+            box.label(text="Skinpack's native library could not be loaded.", icon='ERROR')
+            for line in _wrap(native.load_error(), 60):
+                box.label(text=line)
+            box.label(text="Reinstall the add-on zip built by ./build.sh for this platform.")
+            return
+
+        settings = mesh.skinpack
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(settings, "method")
+        layout.prop(settings, "budget")
+        if settings.budget == 'CUSTOM':
+            layout.prop(settings, "custom_bits")
+        elif settings.budget == 'ERROR':
+            layout.prop(settings, "max_error")
+        layout.prop(settings, "max_influences")
+
+        deform_count, ignored = gather.group_summary(obj)
+        armature = gather.find_armature(obj)
+        layout.label(text="%d deform groups of %s" % (deform_count, armature.name), icon='ARMATURE_DATA')
+        if ignored:
+            layout.label(text="%d other vertex groups ignored (not deform bones)" % len(ignored), icon='INFO')
+
+        row = layout.row()
+        row.scale_y = 1.4
+        row.enabled = not storage.showing_decoded(mesh)
+        row.operator("skinpack.compress", icon='MOD_DATA_TRANSFER')
+
+        result = storage.load_result(mesh)
+        if result is not None:
+            _draw_stats(layout, mesh, result)
+            _draw_preview(layout, context, mesh)
+            col = layout.column(align=True)
+            decoded = storage.showing_decoded(mesh)
+            col.operator("skinpack.toggle_decoded", depress=decoded,
+                         text="Showing Decoded Weights (B)" if decoded else "Show Decoded Weights (A/B)",
+                         icon='ARROW_LEFTRIGHT')
+            col.operator("skinpack.export_gltf", icon='EXPORT')
+        elif storage.showing_decoded(mesh):
+            layout.operator("skinpack.toggle_decoded", text="Restore Original Weights", icon='LOOP_BACK')
+
+
+def _draw_stats(layout, mesh, result):
+    stats = result.stats
+    box = layout.box()
+    if storage.is_stale(mesh, result):
+        box.label(text="Stored result is out of date: compress again", icon='ERROR')
+    grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
+    rows = (
+        ("Method", "%s, K = %d" % (stats["method"].upper(), stats["influences"])),
+        ("Bits / vertex", "%.1f \u2192 %.1f" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"])),
+        ("Ratio", "%.1f : 1" % stats["ratio"]),
+        ("Unique joint tuples", "%d" % stats["unique_tuples"]),
+        ("Tuple / weight bits", "%d + %d" % (stats["tuple_bits"], stats["weight_bits"])),
+        ("Max weight error", "%.2e" % stats["max_error"]),
+        ("RMS weight error", "%.2e" % stats["rms_error"]),
+        ("Pruned vertices", "%d (max %.3f)" % (stats["pruned_vertices"], stats["max_pruning_error"])),
+    )
+    for label, value in rows:
+        grid.label(text=label)
+        grid.label(text=value)
+
+
+def _draw_preview(layout, context, mesh):
+    row = layout.row(align=True)
+    row.operator("skinpack.preview_error", text="Weight Error", icon='GROUP_VCOL').mode = 'WEIGHT'
+    row.operator("skinpack.preview_error", text="Pose Error", icon='POSE_HLT').mode = 'POSE'
+    row.operator("skinpack.clear_preview", text="", icon='X')
+    shown = preview.legend(mesh)
+    if shown is None:
+        return
+    label, minimum, maximum, scale = shown
+    box = layout.box()
+    box.label(text=label)
+    swatches = box.row(align=True)
+    legend = context.window_manager.skinpack_legend
+    for index in range(len(preview.RAMP)):
+        swatches.prop(legend, "color_%d" % index, text="")
+    ticks = box.row()
+    ticks.label(text="0")
+    ticks.label(text="%.2e" % (scale / 2))
+    ticks.label(text="%.2e" % scale)
+    box.label(text="Values %.2e \u2026 %.2e" % (minimum, maximum))
+
+
+def _wrap(text, width):
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = (line + " " + word).strip()
+    return lines + ([line] if line else [])
+
+
+classes = (SKINPACK_PT_skin,)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

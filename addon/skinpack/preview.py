@@ -1,0 +1,162 @@
+"""Error heat map: a colour attribute coloured from per-vertex errors the library reports.
+
+WEIGHT mode shows the library's per-vertex quantisation error (L-inf over the vertex's
+weights, `per_vertex_error` of sp_compress_skin) as stored with the result. POSE mode shows
+how far each vertex moves in the current pose when it is skinned with the decoded instead of
+the original weights: Blender's own depsgraph evaluates the object twice (weights swapped in
+and restored bit-exactly), so the skinning is exactly the one the artist sees.
+"""
+
+import numpy as np
+
+from . import gather, storage
+
+ATTRIBUTE_NAME = "skinpack_error"
+
+# Colour ramp of the heat map (linear RGBA), from no error to the legend's maximum.
+RAMP = (
+    (0.02, 0.05, 0.60, 1.0),  # dark blue
+    (0.00, 0.55, 0.85, 1.0),  # cyan
+    (0.10, 0.75, 0.10, 1.0),  # green
+    (0.95, 0.80, 0.00, 1.0),  # yellow
+    (0.90, 0.05, 0.02, 1.0),  # red
+)
+
+MODE_LABELS = {'WEIGHT': "Weight error (L\u221e), scale = codec bound",
+               'POSE': "Deformation error (scene units), scale = 99th percentile"}
+
+
+class PreviewError(Exception):
+    pass
+
+
+def heat_colors(values, maximum):
+    """(V, 4) float32 colours: values / maximum mapped linearly onto RAMP."""
+    ramp = np.array(RAMP, dtype=np.float32)
+    t = np.clip(values / maximum if maximum > 0 else np.zeros_like(values), 0.0, 1.0) * (len(RAMP) - 1)
+    lower = np.minimum(np.floor(t).astype(np.int64), len(RAMP) - 2)
+    fraction = (t - lower)[:, None].astype(np.float32)
+    return ramp[lower] * (1.0 - fraction) + ramp[lower + 1] * fraction
+
+
+def write_heat_map(obj, values, maximum, mode):
+    """Writes the colour attribute, makes it the active and render colour, stores the legend."""
+    mesh = obj.data
+    existing = mesh.color_attributes.get(ATTRIBUTE_NAME)
+    if existing is not None:
+        mesh.color_attributes.remove(existing)
+    attribute = mesh.color_attributes.new(ATTRIBUTE_NAME, 'FLOAT_COLOR', 'POINT')
+    colors = heat_colors(np.asarray(values, dtype=np.float32), maximum)
+    attribute.data.foreach_set("color", colors.ravel())
+    # Re-fetch by name: adding attributes can reallocate, leaving older references stale.
+    names = [a.name for a in mesh.color_attributes]
+    index = names.index(ATTRIBUTE_NAME)
+    mesh.color_attributes.active_color_index = index
+    mesh.color_attributes.render_color_index = index
+    previous = mesh.get(storage.PREVIEW_KEY, {})
+    mesh[storage.PREVIEW_KEY] = {
+        "mode": mode,
+        "minimum": float(np.min(values)) if len(values) else 0.0,
+        "maximum": float(np.max(values)) if len(values) else 0.0,
+        "scale": float(maximum),
+        "previous_color_type": previous.get("previous_color_type", ""),
+    }
+    mesh.update()
+
+
+def show_in_viewports(context, mesh):
+    """Solid shading coloured by the active colour attribute in every 3D view and for Workbench
+    renders; remembers the scene's previous colour type so Clear can put it back."""
+    scene_shading = context.scene.display.shading
+    info = mesh[storage.PREVIEW_KEY]
+    if not info.get("previous_color_type"):
+        info["previous_color_type"] = scene_shading.color_type
+    scene_shading.color_type = 'VERTEX'
+    screen = context.screen
+    for area in (screen.areas if screen else ()):
+        if area.type != 'VIEW_3D':
+            continue
+        for space in area.spaces:
+            if space.type == 'VIEW_3D':
+                # Only Solid shading can colour by attribute (Wireframe offers Single/Object/Random).
+                space.shading.type = 'SOLID'
+                space.shading.color_type = 'VERTEX'
+        area.tag_redraw()
+
+
+def clear(context, obj):
+    mesh = obj.data
+    attribute = mesh.color_attributes.get(ATTRIBUTE_NAME)
+    if attribute is not None:
+        mesh.color_attributes.remove(attribute)
+    info = mesh.get(storage.PREVIEW_KEY)
+    if info is not None:
+        previous = info.get("previous_color_type")
+        if previous:
+            context.scene.display.shading.color_type = previous
+        del mesh[storage.PREVIEW_KEY]
+    mesh.update()
+
+
+def legend(mesh):
+    """(mode label, minimum, maximum, scale) of the current preview, or None."""
+    info = mesh.get(storage.PREVIEW_KEY) if mesh is not None else None
+    if info is None or mesh.color_attributes.get(ATTRIBUTE_NAME) is None:
+        return None
+    return MODE_LABELS.get(info["mode"], info["mode"]), info["minimum"], info["maximum"], info["scale"]
+
+
+def weight_errors(obj, result):
+    """The library's per-vertex quantisation errors and the codec's bound as the scale."""
+    if storage.is_stale(obj.data, result):
+        raise PreviewError("%s: the stored result does not match the mesh any more; compress again" % obj.name)
+    return result.per_vertex_error, result.stats["error_bound"]
+
+
+def _evaluated_world_positions(context, obj):
+    depsgraph = context.evaluated_depsgraph_get()
+    depsgraph.update()
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        if len(mesh.vertices) != len(obj.data.vertices):
+            raise PreviewError("%s: a modifier changes the vertex count (%d -> %d); the deformation error "
+                               "needs a one-to-one evaluated mesh" % (obj.name, len(obj.data.vertices),
+                                                                      len(mesh.vertices)))
+        positions = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
+        mesh.vertices.foreach_get("co", positions)
+    finally:
+        evaluated.to_mesh_clear()
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    positions = positions.reshape(-1, 3)
+    return positions @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def pose_errors(context, obj, result):
+    """Per-vertex distance (scene units) between the vertex skinned with the original and with
+    the decoded weights in the current pose. The mesh's weights are swapped only for the second
+    evaluation and always written back bit-exactly."""
+    if storage.showing_decoded(obj.data):
+        raise PreviewError("%s shows the decoded weights (A/B); switch back to the originals first" % obj.name)
+    if storage.is_stale(obj.data, result):
+        raise PreviewError("%s: the stored result does not match the mesh any more; compress again" % obj.name)
+    skin = gather.gather(obj)
+    if not storage.matches_weights(result, skin):
+        raise PreviewError("%s: the weights or deform bones changed since compression; compress again" % obj.name)
+    decoded_joints, decoded_weights = result.decode()
+    decoded = gather.decoded_element_weights(skin, decoded_joints, decoded_weights)
+    original_positions = _evaluated_world_positions(context, obj)
+    try:
+        gather.write_element_weights(obj.data, skin.element_counts, decoded, skin.element_weights)
+        obj.data.update()
+        decoded_positions = _evaluated_world_positions(context, obj)
+    finally:
+        gather.write_element_weights(obj.data, skin.element_counts, skin.element_weights, decoded)
+        obj.data.update()
+    distances = np.linalg.norm(decoded_positions - original_positions, axis=1).astype(np.float32)
+    # A few pruned vertices usually dominate the maximum; scaling the ramp to the 99th
+    # percentile keeps the rest of the mesh readable (the legend shows both, red = scale and above).
+    scale = float(np.percentile(distances, 99)) if len(distances) else 0.0
+    if scale <= 0.0:
+        scale = float(distances.max()) if len(distances) else 0.0
+    return distances, scale

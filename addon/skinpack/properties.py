@@ -1,0 +1,82 @@
+"""Settings stored with the mesh (compression) and the scene (glTF export)."""
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
+
+from . import preview
+
+METHOD_ITEMS = (
+    ('OSS', "Optimal Simplex", "Optimal simplex sampling: the densest code for a bit budget (the paper's best)"),
+    ('ANY', "Any AABB", "Independent samples per weight axis"),
+    ('POT', "POT AABB", "Fixed-point weights with the always-zero high bits dropped"),
+    ('CUBE', "Unit Cube", "K-1 fixed-point weights, the largest one recomputed"),
+    ('FIXED', "Fixed", "K fixed-point weights, nothing recomputed"),
+)
+
+BUDGET_ITEMS = (
+    ('32', "32 bits", "One 32-bit word per vertex (tuple index + weight code)"),
+    ('48', "48 bits", "48 bits per vertex (stored in two words)"),
+    ('64', "64 bits", "Two 32-bit words per vertex"),
+    ('CUSTOM', "Custom", "A bit budget of your choice for tuple index + weight code"),
+    ('ERROR', "Max Error", "The fewest weight bits whose proven error bound meets a target"),
+)
+
+
+class SkinpackMeshSettings(bpy.types.PropertyGroup):
+    method: EnumProperty(name="Method", items=METHOD_ITEMS, default='OSS',
+                         description="Weight codec")
+    budget: EnumProperty(name="Budget", items=BUDGET_ITEMS, default='32',
+                         description="Bits per vertex for tuple index and weight code, or an error target")
+    custom_bits: IntProperty(name="Bits per Vertex", default=40, min=2, max=64,
+                             description="Budget for tuple index + weight code of one vertex")
+    max_error: FloatProperty(name="Max Weight Error", default=0.001, min=1e-9, max=0.5, precision=5,
+                             description="Largest allowed weight error (L-inf); picks the fewest weight bits "
+                                         "whose proven bound meets it")
+    max_influences: IntProperty(name="Max Influences", default=4, min=1, max=4,
+                                description="Influences kept per vertex (K); the smallest weights are pruned")
+
+    def options_summary(self):
+        return {"method": self.method.lower(), "budget": self.budget, "custom_bits": self.custom_bits,
+                "max_error": self.max_error, "max_influences": self.max_influences}
+
+
+class SkinpackExportSettings(bpy.types.PropertyGroup):
+    enabled: BoolProperty(name="Skinpack", default=True,
+                          description="Write SKINPACK_packed_skin for every skinned primitive")
+    mode: EnumProperty(name="Mode", default='FALLBACK', items=(
+        ('FALLBACK', "Fallback", "Keep JOINTS_0/WEIGHTS_0 so every viewer opens the file; the extension is optional"),
+        ('COMPACT', "Compact", "Drop JOINTS_0/WEIGHTS_0; the extension is required to read the skin"),
+    ), description="Whether the uncompressed attributes stay in the file")
+
+
+def _legend_property(index):
+    # Read-only swatches of the heat-map colour ramp, drawn in the panel's legend.
+    return FloatVectorProperty(name="Colour %d" % index, subtype='COLOR', size=3, min=0.0, max=1.0,
+                               get=lambda self: preview.RAMP[index][:3], set=lambda self, value: None)
+
+
+class SkinpackLegend(bpy.types.PropertyGroup):
+    color_0: _legend_property(0)
+    color_1: _legend_property(1)
+    color_2: _legend_property(2)
+    color_3: _legend_property(3)
+    color_4: _legend_property(4)
+
+
+classes = (SkinpackMeshSettings, SkinpackExportSettings, SkinpackLegend)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Mesh.skinpack = PointerProperty(type=SkinpackMeshSettings)
+    bpy.types.Scene.skinpack_export = PointerProperty(type=SkinpackExportSettings)
+    bpy.types.WindowManager.skinpack_legend = PointerProperty(type=SkinpackLegend)
+
+
+def unregister():
+    del bpy.types.WindowManager.skinpack_legend
+    del bpy.types.Scene.skinpack_export
+    del bpy.types.Mesh.skinpack
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

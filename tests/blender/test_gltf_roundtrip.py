@@ -1,0 +1,227 @@
+"""glTF: Blender's exporter writes SKINPACK_packed_skin (fallback and compact) through the
+add-on's hooks; the files pass the Khronos validator; the CLI decodes them to weights within the
+bound of the exporter's own (uncompressed) weights and agrees on every statistic and every
+packed word; the importer hook opens them with the decoded weights."""
+
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import common  # noqa: E402
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+CONTRACT_KEYS = {"vertices", "tupleTable", "influences", "jointCount", "method", "n", "weightBits", "tupleBits",
+                 "maxError"}
+EXTENSION = "SKINPACK_packed_skin"
+
+
+def export_plain(path, obj):
+    """The reference: Blender's exporter with the Skinpack section switched off."""
+    bpy.context.scene.skinpack_export.enabled = False
+    try:
+        common.make_active(obj)
+        obj.find_armature().select_set(True)
+        bpy.ops.export_scene.gltf(filepath=path, export_format='GLB', use_selection=True)
+    finally:
+        bpy.context.scene.skinpack_export.enabled = True
+
+
+def check_contract(path, compact):
+    glb = common.Glb(path)
+    used = glb.json.get("extensionsUsed", [])
+    required = glb.json.get("extensionsRequired", [])
+    common.check(EXTENSION in used, "%s: extension not in extensionsUsed" % path)
+    common.check((EXTENSION in required) == compact, "%s: extensionsRequired %s" % (path, required))
+    found = 0
+    for _, _, primitive in glb.skinned_primitives():
+        extension = primitive.get("extensions", {}).get(EXTENSION)
+        if extension is None:
+            continue
+        found += 1
+        common.check(CONTRACT_KEYS <= set(extension), "%s: keys %s" % (path, sorted(extension)))
+        common.check(("axisSamples" in extension) == (extension["method"] == "any"), "%s: axisSamples" % path)
+        words = glb.json["accessors"][extension["vertices"]]
+        table = glb.json["accessors"][extension["tupleTable"]]
+        common.check(words["componentType"] == 5125 and words["type"] in ("SCALAR", "VEC2"), "vertices accessor")
+        expected_lut = 5121 if extension["jointCount"] <= 256 else 5123
+        common.check(table["componentType"] == expected_lut, "tupleTable component type")
+        common.check(common.GLTF_WIDTHS[table["type"]] == extension["influences"], "tupleTable type")
+        lut = glb.accessor(extension["tupleTable"])
+        common.check(table["min"] == lut.min(axis=0).tolist() and table["max"] == lut.max(axis=0).tolist()
+                     and max(table["max"]) < extension["jointCount"], "%s: tupleTable min/max" % path)
+        for key in ("JOINTS_0", "WEIGHTS_0"):
+            accessor = glb.json["accessors"][primitive["attributes"][key]]
+            # Compact: the attribute stays, as an accessor without data (docs/extension/README.md).
+            common.check(("bufferView" in accessor) != compact, "%s: %s bufferView in %s mode"
+                         % (path, key, "compact" if compact else "fallback"))
+            common.check(accessor["count"] == glb.json["accessors"][extension["vertices"]]["count"], key + " count")
+        if compact:
+            common.check("JOINTS_1" not in primitive["attributes"], "%s: JOINTS_1 left in compact mode" % path)
+    common.check(found > 0, "%s: no primitive carries %s (a swallowed hook exception?)" % (path, EXTENSION))
+    return glb
+
+
+def validate(args, path):
+    if not args.validator:
+        raise AssertionError("no Khronos validator (tools/validate.mjs) configured")
+    run = subprocess.run(["node", args.validator, "--json", path], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+    report = json.loads(run.stdout.strip().splitlines()[-1])
+    errors = [m for m in report["issues"]["messages"] if m["severity"] == 0]
+    print("validator %s: %d errors, %d warnings" % (os.path.basename(path), report["issues"]["numErrors"],
+                                                   report["issues"]["numWarnings"]))
+    return errors
+
+
+def skin_of(glb, primitive_attributes):
+    joints = [glb.accessor(primitive_attributes[k]) for k in sorted(primitive_attributes) if k.startswith("JOINTS_")]
+    weights = [glb.accessor(primitive_attributes[k]) for k in sorted(primitive_attributes) if k.startswith("WEIGHTS_")]
+    return np.concatenate(joints, axis=1), np.concatenate(weights, axis=1)
+
+
+def cli(args, *command):
+    run = subprocess.run([args.cli] + list(command), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    common.check(run.returncode == 0, "skinpack %s failed: %s" % (" ".join(command), run.stderr))
+    return run.stdout
+
+
+def main():
+    args = common.arguments()
+    common.check(bool(args.cli), "the skinpack CLI is not built (native/cli needs libtinygltf-dev)")
+    common.install_addon(args.zip)
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+
+    for blend, name in (("RE_Player_female.blend", "RE_Player"), ("skinned_cylinder.blend", "Cylinder"),
+                        ("RobotExpressive.blend", "Hand.L")):
+        obj = common.open_asset(args, blend, name)
+        base = os.path.join(args.out, name.replace(".", "_"))
+        reference = base + "_plain.glb"
+        export_plain(reference, obj)
+        # Snapshot after the plain export: Blender 3.4's exporter itself clamps weights above 1
+        # in the scene's mesh (RE_Player has four); ours must change nothing beyond that.
+        before = common.weight_snapshot(obj.data)
+        common.check(EXTENSION not in common.Glb(reference).json.get("extensionsUsed", []), "plain export packed")
+
+        # Blender's own File > Export > glTF with the Skinpack section on (its default): packed.
+        via_exporter = base + "_exporter_compact.glb"
+        bpy.context.scene.skinpack_export.mode = 'COMPACT'
+        common.make_active(obj)
+        obj.find_armature().select_set(True)
+        bpy.ops.export_scene.gltf(filepath=via_exporter, export_format='GLB', use_selection=True)
+        bpy.context.scene.skinpack_export.mode = 'FALLBACK'
+        check_contract(via_exporter, compact=True)
+
+        # With the error preview on, the heat map (the render colour) must not become COLOR_0.
+        common.make_active(obj)
+        bpy.ops.skinpack.compress()
+        bpy.ops.skinpack.preview_error(mode='WEIGHT')
+
+        outputs = {}
+        for mode in ("FALLBACK", "COMPACT"):
+            path = "%s_%s.glb" % (base, mode.lower())
+            common.make_active(obj)
+            common.check(bpy.ops.skinpack.export_gltf(filepath=path, mode=mode) == {'FINISHED'}, "export " + mode)
+            outputs[mode] = (path, list(exporter.last_report))
+            glb = check_contract(path, mode == 'COMPACT')
+            for _, _, primitive in glb.skinned_primitives():
+                common.check("COLOR_0" not in primitive["attributes"], "%s: the heat map was exported" % path)
+        common.assert_same_weights(before, common.weight_snapshot(obj.data), name + " after export")
+
+        # Khronos validator: no errors in any file.
+        for path in (reference, outputs["FALLBACK"][0], outputs["COMPACT"][0]):
+            errors = validate(args, path)
+            common.check(errors == [], "%s: validator errors %s" % (path, errors))
+
+        # The CLI compresses the plain export with the same settings: identical stats and words.
+        cli_path = base + "_cli.glb"
+        report = json.loads(cli(args, "compress", reference, "-o", cli_path, "--method", "oss", "--vertex-bits", "32",
+                                "--fallback", "--json"))
+        cli_primitives = report["primitives"]
+        hook_stats = [entry["stats"] for entry in outputs["FALLBACK"][1]]
+        common.check(len(cli_primitives) == len(hook_stats), "primitive count: CLI %d, hook %d"
+                     % (len(cli_primitives), len(hook_stats)))
+        for ours, theirs in zip(hook_stats, cli_primitives):
+            for key, cli_key in (("vertices", "vertices"), ("unique_tuples", "unique_tuples"),
+                                 ("tuple_bits", "tuple_bits"), ("weight_bits", "weight_bits"), ("n", "n"),
+                                 ("influences", "influences"), ("joint_count", "joints")):
+                common.check(ours[key] == theirs[cli_key], "%s %s: hook %s, CLI %s" % (name, key, ours[key],
+                                                                                     theirs[cli_key]))
+            common.check(abs(ours["bits_per_vertex"] - theirs["bits_per_vertex"]) < 1e-4, "bits per vertex")
+            common.check(abs(ours["error_bound"] - theirs["max_error_bound"]) < 1e-9, "error bound")
+        ours_glb, cli_glb = common.Glb(outputs["FALLBACK"][0]), common.Glb(cli_path)
+        for (_, _, p_ours), (_, _, p_cli) in zip(ours_glb.skinned_primitives(), cli_glb.skinned_primitives()):
+            e_ours, e_cli = p_ours["extensions"][EXTENSION], p_cli["extensions"][EXTENSION]
+            common.check(np.array_equal(ours_glb.accessor(e_ours["vertices"]), cli_glb.accessor(e_cli["vertices"])),
+                         "%s: packed words differ from the CLI's" % name)
+            common.check(np.array_equal(ours_glb.accessor(e_ours["tupleTable"]), cli_glb.accessor(e_cli["tupleTable"])),
+                         "%s: tuple table differs from the CLI's" % name)
+            for key in CONTRACT_KEYS - {"vertices", "tupleTable"}:
+                common.check(e_ours[key] == e_cli[key] or (key == "maxError" and abs(e_ours[key] - e_cli[key]) < 1e-12),
+                             "%s: extension %s: ours %r, CLI %r" % (name, key, e_ours[key], e_cli[key]))
+
+        # skinpack decompress of both files: weights within maxError of the exporter's own.
+        plain = common.Glb(reference)
+        plain_primitives = list(plain.skinned_primitives())
+        decoded_maps = {}
+        for mode in ("FALLBACK", "COMPACT"):
+            decoded_path = "%s_%s_decoded.glb" % (base, mode.lower())
+            cli(args, "decompress", outputs[mode][0], "-o", decoded_path)
+            decoded = common.Glb(decoded_path)
+            common.check(validate(args, decoded_path) == [], "decompressed file invalid")
+            packed = common.Glb(outputs[mode][0])
+            for (_, _, p_plain), (_, _, p_dec), (_, _, p_packed) in zip(plain_primitives, decoded.skinned_primitives(),
+                                                                       packed.skinned_primitives()):
+                bound = p_packed["extensions"][EXTENSION]["maxError"]
+                original = common.joint_weight_maps(*skin_of(plain, p_plain["attributes"]))
+                result = common.joint_weight_maps(*skin_of(decoded, p_dec["attributes"]))
+                difference = common.max_map_difference(original, result)
+                print("%s %s: max |decoded - exported| %.3g (bound %.3g)" % (name, mode, difference, bound))
+                # float32 inputs and outputs: allow rounding of the last bits on top of the bound
+                common.check(difference <= bound + 1e-6, "%s %s: weight error %g above bound %g"
+                             % (name, mode, difference, bound))
+                decoded_maps.setdefault(mode, []).append(result)
+        common.check(decoded_maps["FALLBACK"] == decoded_maps["COMPACT"], "modes decode differently")
+
+        # Import through the hook: the compact file (which has no JOINTS_0) gets its weights.
+        for mode in ("COMPACT", "FALLBACK"):
+            check_import(outputs[mode][0], decoded_maps[mode], plain)
+
+
+def check_import(path, decoded_maps, plain):
+    """Imported vertex groups hold the decoded weights: per joint name, the sum and the number of
+    non-zero weights over all imported vertices equal the decoded file's."""
+    joint_names = [plain.json["nodes"][j]["name"] for j in plain.json["skins"][0]["joints"]]
+    expected_sum, expected_count = {}, {}
+    for primitive_maps in decoded_maps:
+        for entry in primitive_maps:
+            for joint, weight in entry.items():
+                key = joint_names[joint] if joint < len(joint_names) else "neutral_bone"
+                expected_sum[key] = expected_sum.get(key, 0.0) + weight
+                expected_count[key] = expected_count.get(key, 0) + 1
+    existing = set(bpy.data.objects)
+    bpy.ops.import_scene.gltf(filepath=path)
+    imported = [o for o in bpy.data.objects if o not in existing and o.type == 'MESH' and len(o.vertex_groups)]
+    common.check(len(imported) == 1, "%s: %d skinned meshes imported" % (path, len(imported)))
+    obj = imported[0]
+    names = [g.name for g in obj.vertex_groups]
+    got_sum, got_count = {}, {}
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            if element.weight > 0:
+                key = names[element.group]
+                got_sum[key] = got_sum.get(key, 0.0) + element.weight
+                got_count[key] = got_count.get(key, 0) + 1
+    common.check(len(obj.data.vertices) == sum(len(m) for m in decoded_maps), "imported vertex count")
+    common.check(got_count == expected_count, "%s: imported influence counts differ from the decoded file" % path)
+    worst = max(abs(got_sum[k] - expected_sum[k]) for k in expected_sum)
+    common.check(worst < 1e-3, "%s: imported weight sums differ by %g" % (path, worst))
+    print("import %s: %d vertices, %d groups match the decoded weights" % (os.path.basename(path),
+                                                                          len(obj.data.vertices), len(got_sum)))
+    bpy.data.objects.remove(obj)
+
+
+common.run(main)

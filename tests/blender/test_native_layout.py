@@ -1,0 +1,79 @@
+"""The ctypes mirror of skinpack.h matches the C layout, and the binding round-trips a skin.
+
+The C side is printed by skinpack_struct_layout (sizeof/offsetof as the compiler sees them);
+any drift in field order, type or count fails here before it can corrupt a call.
+"""
+
+import ctypes
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import common  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+
+def main():
+    args = common.arguments()
+    common.install_addon(args.zip)
+    from skinpack import native
+
+    common.check(native.load() is not None, "library did not load: %s" % native.load_error())
+    layout = json.loads(subprocess.check_output([args.layout], text=True))
+    for c_name, mirror in native.MIRRORED_STRUCTS.items():
+        c_struct = layout[c_name]
+        common.check(ctypes.sizeof(mirror) == c_struct["size"],
+                     "%s: ctypes size %d, C size %d" % (c_name, ctypes.sizeof(mirror), c_struct["size"]))
+        fields = [name for name, _ in mirror._fields_]
+        common.check(fields == list(c_struct["fields"]), "%s: field order %s vs C %s"
+                     % (c_name, fields, list(c_struct["fields"])))
+        for name in fields:
+            offset = getattr(mirror, name).offset
+            common.check(offset == c_struct["fields"][name], "%s.%s: ctypes offset %d, C offset %d"
+                         % (c_name, name, offset, c_struct["fields"][name]))
+
+    # Defaults come from the library, not from Python.
+    options = native.default_options()
+    common.check(native.METHODS[options.method] == "oss" and options.max_influences == 4
+                 and options.vertex_bits == 32 and options.merge_dont_care == 1,
+                 "unexpected defaults from sp_compress_options_default")
+
+    # A random skin through compress and decompress: the decoded weights are within the
+    # codec's bound of the prepared (sorted, normalised) input, for every method.
+    rng = np.random.default_rng(7)
+    vertex_count, joint_count = 5000, 40
+    joints = np.stack([rng.choice(joint_count, 4, replace=False) for _ in range(vertex_count)]).astype(np.uint16)
+    weights = rng.random((vertex_count, 4)).astype(np.float32) ** 3
+    weights /= weights.sum(axis=1, keepdims=True)
+    for method in native.METHODS:
+        compressed = native.compress(joints, weights, joint_count, native.make_options(method, 4, vertex_bits=48))
+        skin = compressed.skin
+        common.check(skin.vertex_count == vertex_count and skin.influences == 4, method + ": counts")
+        common.check(skin.tuple_bits + skin.weight_bits <= 48, method + ": budget exceeded")
+        common.check(0 < skin.quantization.max_error <= skin.codec.max_error + 1e-6,
+                     "%s: max error %g vs bound %g" % (method, skin.quantization.max_error, skin.codec.max_error))
+        decoded_joints, decoded_weights = compressed.decode()
+        order = np.argsort(-weights, axis=1, kind="stable")
+        reference = np.take_along_axis(weights, order, axis=1)
+        reference_joints = np.take_along_axis(joints, order, axis=1)
+        error = np.abs(decoded_weights - reference).max(axis=1)
+        common.check(np.allclose(error, compressed.per_vertex_error, atol=2e-6),
+                     method + ": library per-vertex error disagrees with decode")
+        significant = decoded_weights > 0
+        common.check((decoded_joints[significant] == reference_joints[significant]).all(), method + ": joints")
+
+    # Errors come back as SkinpackError naming the vertex, not as a crash.
+    bad = weights.copy()
+    bad[123, 0] = np.nan
+    try:
+        native.compress(joints, bad, joint_count, native.make_options("oss", 4, vertex_bits=32))
+    except native.SkinpackError as error:
+        common.check(error.code == native.SP_ERR_NONFINITE_WEIGHT and error.vertex == 123, "error %r" % error)
+    else:
+        raise AssertionError("NaN weight accepted")
+
+
+common.run(main)
