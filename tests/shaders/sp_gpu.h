@@ -1,0 +1,52 @@
+/*
+ * sp_gpu.h - host-side helpers shared by the shader harness and the GPU benchmark: the codec
+ * parameter block for the shaders, the exported mesh files, and the C reference skinning.
+ */
+#ifndef SKINPACK_SP_GPU_H
+#define SKINPACK_SP_GPU_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "skinpack.h"
+#include "skinpack_gpu_layout.h"
+#include "vk_context.h"
+
+/* The shaders' view of a codec and of the vertex words / LUT that go with it. */
+SpGpuCodec sp_gpu_codec_fill(const sp_codec* codec, uint32_t tuple_bits, uint32_t words_per_vertex,
+                             uint32_t joint_bytes, uint32_t lut_size, uint32_t joint_count);
+
+/* Specialisation for a vertex format; with a codec (PACKED), also its method, K and decoder,
+ * so the pipeline holds only the decoder that codec needs. codec NULL: all runtime. */
+vkx_specialization sp_gpu_specialization(uint32_t vertex_format, const SpGpuCodec* codec);
+
+/*
+ * A skinned mesh exported by export_skin_mesh.py (little-endian):
+ *   char magic[8] = "SPSKIN01"; u32 vertex_count, triangle_count, joint_count, influences (8), pose_count
+ *   f32 positions[3 V]; u32 indices[3 T]; u16 joints[8 V]; f32 weights[8 V]
+ *   f32 pose_rows[pose_count][joint_count][12]   rest-to-pose 3x4 matrices, row-major, mesh space
+ *   char name[64]
+ */
+typedef struct sp_skin_mesh {
+    char name[64];
+    uint32_t vertex_count, triangle_count, joint_count, influences, pose_count;
+    float* positions;
+    uint32_t* indices;
+    uint16_t* joints;
+    float* weights;
+    float* pose_rows;
+} sp_skin_mesh;
+
+/* Loads a mesh file; exits with a FAIL message when it is missing or malformed. */
+void sp_skin_mesh_load(const char* path, sp_skin_mesh* mesh);
+void sp_skin_mesh_free(sp_skin_mesh* mesh);
+
+/* C reference of skin_common.glsl's skin_position: K influences per vertex (weights and joints
+ * dense, K each), 3x4 row-major matrices; double accumulation. out: 3 floats per vertex. */
+void sp_reference_skin(const float* positions, size_t vertex_count, const uint16_t* joints, const float* weights,
+                       size_t influences, const float* matrix_rows, float* out);
+
+/* Seconds since an arbitrary start (CLOCK_MONOTONIC). */
+double sp_seconds(void);
+
+#endif
