@@ -319,7 +319,8 @@ void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
     }
 }
 
-/* A code an encoder can write: in range and, for the AABB methods, inside the simplex. */
+/* A code an encoder can write: in range and, for the grid methods, a sorted grid point
+ * (encoders only write sorted tuples; the AABB codecs also have codes outside the simplex). */
 static int code_is_valid(const sp_codec* codec, uint64_t code)
 {
     uint32_t k = codec->influences;
@@ -340,7 +341,11 @@ static int code_is_valid(const sp_codec* codec, uint64_t code)
         shift += bits;
         sum += q[i];
     }
-    return codec->method == SP_METHOD_FIXED ? sum == codec->scale : sum <= codec->scale;
+    if (codec->method == SP_METHOD_FIXED ? sum != codec->scale : sum > codec->scale) return 0;
+    if (first) q[0] = codec->scale - (uint64_t)sum;
+    for (uint32_t i = 1; i < k; ++i)
+        if (q[i] > q[i - 1]) return 0;
+    return 1;
 }
 
 sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,

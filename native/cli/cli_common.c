@@ -1,0 +1,253 @@
+/* cli_common.c - decoding and accounting shared by the glTF commands (see cli_common.h). */
+#include "cli_common.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static int fail(char* err, size_t err_size, const char* format, ...) {
+    va_list args;
+    va_start(args, format);
+    vsnprintf(err, err_size, format, args);
+    va_end(args);
+    return -1;
+}
+
+int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
+                             uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
+                             size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
+    memset(out, 0, sizeof(*out));
+    if (packed->influences < 1 || packed->influences > SP_MAX_INFLUENCES)
+        return fail(err, err_size, "influences %u is out of range 1..%d", packed->influences, SP_MAX_INFLUENCES);
+    if (packed->joint_count < 1 || packed->joint_count > SP_MAX_JOINTS)
+        return fail(err, err_size, "jointCount %u is out of range 1..%d", packed->joint_count, SP_MAX_JOINTS);
+    if (skin_joint_count && packed->joint_count > skin_joint_count)
+        return fail(err, err_size, "jointCount %u is larger than the skin's %zu joints", packed->joint_count,
+                     skin_joint_count);
+    if (packed->weight_bits > SP_MAX_WEIGHT_BITS || packed->tuple_bits > 32)
+        return fail(err, err_size, "bit widths out of range (weightBits %u, tupleBits %u)", packed->weight_bits,
+                     packed->tuple_bits);
+    if (lut_size == 0) return fail(err, err_size, "the tuple table is empty");
+    if (packed->tuple_bits != sp_index_bits(lut_size))
+        return fail(err, err_size, "tupleBits %u does not match the tuple table's %zu entries (needs %u)",
+                     packed->tuple_bits, lut_size, sp_index_bits(lut_size));
+
+    sp_codec codec;
+    const uint64_t* axes = packed->method == SP_METHOD_ANY ? packed->axis_samples : NULL;
+    sp_result r = sp_codec_from_params((sp_method)packed->method, packed->influences, packed->n, axes, &codec);
+    if (r != SP_OK)
+        return fail(err, err_size, "invalid codec parameters (method %s, influences %u, n %llu): %s",
+                     sp_method_name((sp_method)packed->method), packed->influences, (unsigned long long)packed->n,
+                     sp_result_string(r));
+    if (codec.bits != packed->weight_bits)
+        return fail(err, err_size, "weightBits %u does not match the codec, which needs %u", packed->weight_bits,
+                     codec.bits);
+    uint32_t wpv = sp_words_per_vertex(packed->tuple_bits, packed->weight_bits);
+    if (wpv == 0 || wpv != words_per_vertex)
+        return fail(err, err_size, "%u bits a vertex need %u words, the vertices accessor has %u",
+                     packed->tuple_bits + packed->weight_bits, wpv, words_per_vertex);
+
+    uint32_t k = packed->influences;
+    out->joints = (uint16_t*)malloc(vertex_count * k * sizeof(uint16_t));
+    out->weights = (float*)malloc(vertex_count * k * sizeof(float));
+    if (!out->joints || !out->weights) {
+        cli_decoded_skin_free(out);
+        return fail(err, err_size, "out of memory");
+    }
+    size_t bad_vertex = 0;
+    r = sp_decompress_skin(&codec, words, vertex_count, packed->tuple_bits, lut, lut_size, packed->joint_count,
+                           out->joints, out->weights, &bad_vertex);
+    if (r != SP_OK) {
+        cli_decoded_skin_free(out);
+        return fail(err, err_size, "vertex %zu: %s", bad_vertex, sp_result_string(r));
+    }
+    out->codec = codec;
+    out->vertex_count = vertex_count;
+    out->lut_size = lut_size;
+    out->influences = k;
+    out->words_per_vertex = wpv;
+    out->joint_bytes = packed->joint_count <= 256 ? 1 : 2;
+    return 0;
+}
+
+int cli_decode_packed(const gltf_doc* doc, size_t mesh, const gltf_packed_skin* packed, cli_decoded_skin* out,
+                      char* err, size_t err_size) {
+    size_t vertex_count = 0, lut_size = 0;
+    uint32_t words_per_vertex = 0;
+    memset(out, 0, sizeof(*out));
+    if (gltf_packed_sizes(doc, packed, &vertex_count, &words_per_vertex, &lut_size, err, err_size)) return -1;
+    uint32_t* words = (uint32_t*)malloc(vertex_count * words_per_vertex * sizeof(uint32_t));
+    uint16_t* lut = (uint16_t*)malloc(lut_size * packed->influences * sizeof(uint16_t));
+    int rc = -1;
+    if (!words || !lut)
+        fail(err, err_size, "out of memory");
+    else if (gltf_read_packed(doc, packed, words, lut, err, err_size) == 0) {
+        rc = cli_decode_packed_arrays(packed, words, vertex_count, words_per_vertex, lut, lut_size,
+                                      gltf_mesh_joint_count(doc, mesh), out, err, err_size);
+    }
+    free(words);
+    free(lut);
+    return rc;
+}
+
+int cli_check_meshlets(const gltf_doc* doc, const gltf_packed_skin* packed, size_t vertex_count,
+                       cli_meshlet_summary* summary, char* err, size_t err_size) {
+    const gltf_packed_meshlets* ml = &packed->meshlets;
+    uint32_t k = packed->influences;
+    size_t n = 0, n_counts = 0, n_bounds = 0, n_vertices = 0, n_vtuples = 0, n_tri = 0, n_joints = 0, n_tuples = 0;
+    memset(summary, 0, sizeof(*summary));
+    if (gltf_read_accessor_u32(doc, ml->offsets, GLTF_UNSIGNED_INT, 4, &n, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->counts, GLTF_UNSIGNED_SHORT, 4, &n_counts, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->bounds, GLTF_FLOAT, 4, &n_bounds, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->vertices, GLTF_UNSIGNED_INT, 1, &n_vertices, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->vertex_tuples, GLTF_UNSIGNED_BYTE, 1, &n_vtuples, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->triangles, GLTF_UNSIGNED_BYTE, 1, &n_tri, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->joints, GLTF_UNSIGNED_SHORT, 1, &n_joints, NULL, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->tuples, GLTF_UNSIGNED_BYTE, (int)k, &n_tuples, NULL, err, err_size))
+        return -1;
+    if (n_counts != n || n_bounds != n || n_vtuples != n_vertices || n_tri % 3)
+        return fail(err, err_size, "meshlets: accessor counts disagree");
+    uint32_t* offsets = malloc(n * 4 * sizeof(uint32_t));
+    uint32_t* counts = malloc(n * 4 * sizeof(uint32_t));
+    uint32_t* vertices = malloc(n_vertices * sizeof(uint32_t));
+    uint32_t* vtuples = malloc(n_vertices * sizeof(uint32_t));
+    uint32_t* triangles = malloc(n_tri * sizeof(uint32_t));
+    uint32_t* joints = malloc(n_joints * sizeof(uint32_t));
+    uint32_t* tuples = malloc(n_tuples * k * sizeof(uint32_t));
+    int rc = -1;
+    size_t t;
+    if (!offsets || !counts || !vertices || !vtuples || !triangles || !joints || !tuples) {
+        fail(err, err_size, "out of memory");
+        goto done;
+    }
+    if (gltf_read_accessor_u32(doc, ml->offsets, GLTF_UNSIGNED_INT, 4, &t, offsets, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->counts, GLTF_UNSIGNED_SHORT, 4, &t, counts, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->vertices, GLTF_UNSIGNED_INT, 1, &t, vertices, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->vertex_tuples, GLTF_UNSIGNED_BYTE, 1, &t, vtuples, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->triangles, GLTF_UNSIGNED_BYTE, 1, &t, triangles, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->joints, GLTF_UNSIGNED_SHORT, 1, &t, joints, err, err_size) ||
+        gltf_read_accessor_u32(doc, ml->tuples, GLTF_UNSIGNED_BYTE, (int)k, &t, tuples, err, err_size))
+        goto done;
+    double joint_sum = 0, tuple_bits_sum = 0;
+    size_t entries = 0;
+    for (size_t m = 0; m < n; ++m) {
+        uint64_t vo = offsets[4 * m], to = offsets[4 * m + 1], jo = offsets[4 * m + 2], uo = offsets[4 * m + 3];
+        uint32_t vc = counts[4 * m], tc = counts[4 * m + 1], jc = counts[4 * m + 2], uc = counts[4 * m + 3];
+        if (vo + vc > n_vertices || (to + tc) * 3 > n_tri || jo + jc > n_joints || uo + uc > n_tuples || !vc || !tc ||
+            !jc || !uc || (ml->max_vertices && vc > ml->max_vertices) ||
+            (ml->max_triangles && tc > ml->max_triangles) || (ml->max_joints && jc > ml->max_joints)) {
+            fail(err, err_size, "meshlet %zu: offsets or counts out of range", m);
+            goto done;
+        }
+        for (uint32_t i = 0; i < vc; ++i)
+            if (vertices[vo + i] >= vertex_count || vtuples[vo + i] >= uc) {
+                fail(err, err_size, "meshlet %zu vertex %u: source vertex or local tuple out of range", m, i);
+                goto done;
+            }
+        for (uint32_t i = 0; i < 3 * tc; ++i)
+            if (triangles[3 * to + i] >= vc) {
+                fail(err, err_size, "meshlet %zu: triangle index %u out of range", m, triangles[3 * to + i]);
+                goto done;
+            }
+        for (uint32_t i = 0; i < jc; ++i)
+            if (joints[jo + i] >= packed->joint_count) {
+                fail(err, err_size, "meshlet %zu: palette joint %u out of range", m, joints[jo + i]);
+                goto done;
+            }
+        for (uint32_t i = 0; i < uc * k; ++i)
+            if (tuples[uo * k + i] >= jc) {
+                fail(err, err_size, "meshlet %zu: local tuple entry %u past the palette", m, tuples[uo * k + i]);
+                goto done;
+            }
+        if (vc > summary->max_vertices) summary->max_vertices = vc;
+        if (tc > summary->max_triangles) summary->max_triangles = tc;
+        if (jc > summary->max_joints) summary->max_joints = jc;
+        joint_sum += jc;
+        tuple_bits_sum += (double)vc * sp_index_bits(uc);
+        entries += vc;
+    }
+    summary->count = n;
+    summary->mean_joints = n ? joint_sum / (double)n : 0;
+    summary->local_tuple_bits_mean = entries ? tuple_bits_sum / (double)entries : 0;
+    rc = 0;
+done:
+    free(offsets);
+    free(counts);
+    free(vertices);
+    free(vtuples);
+    free(triangles);
+    free(joints);
+    free(tuples);
+    return rc;
+}
+
+void cli_decoded_skin_free(cli_decoded_skin* skin) {
+    free(skin->joints);
+    free(skin->weights);
+    skin->joints = NULL;
+    skin->weights = NULL;
+}
+
+double cli_lut_bits_per_vertex(size_t lut_size, uint32_t influences, uint32_t joint_bytes, size_t vertex_count) {
+    return vertex_count ? (double)lut_size * influences * 8.0 * joint_bytes / (double)vertex_count : 0.0;
+}
+
+static float weight_of(const uint16_t* joints, const float* weights, size_t k, uint16_t joint) {
+    float sum = 0;
+    for (size_t i = 0; i < k; ++i)
+        if (joints[i] == joint) sum += weights[i];
+    return sum;
+}
+
+double cli_vertex_difference(const uint16_t* joints_a, const float* weights_a, size_t k_a, const uint16_t* joints_b,
+                             const float* weights_b, size_t k_b) {
+    double worst = 0;
+    for (size_t i = 0; i < k_a; ++i) {
+        if (weights_a[i] == 0) continue;
+        double d = fabs((double)weight_of(joints_a, weights_a, k_a, joints_a[i]) -
+                        (double)weight_of(joints_b, weights_b, k_b, joints_a[i]));
+        if (d > worst) worst = d;
+    }
+    for (size_t i = 0; i < k_b; ++i) {
+        if (weights_b[i] == 0) continue;
+        double d = fabs((double)weight_of(joints_a, weights_a, k_a, joints_b[i]) -
+                        (double)weight_of(joints_b, weights_b, k_b, joints_b[i]));
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
+size_t cli_file_size(const char* path) {
+    struct stat st;
+    return stat(path, &st) == 0 ? (size_t)st.st_size : 0;
+}
+
+int cli_output_is_binary(const char* path, int input_binary) {
+    size_t n = strlen(path);
+    if (n >= 4 && strcmp(path + n - 4, ".glb") == 0) return 1;
+    if (n >= 5 && strcmp(path + n - 5, ".gltf") == 0) return 0;
+    return input_binary;
+}
+
+void cli_json_string(FILE* out, const char* s) {
+    fputc('"', out);
+    for (; *s; ++s) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(out, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(out, "\\u%04x", c);
+        else
+            fputc(c, out);
+    }
+    fputc('"', out);
+}
+
+void cli_json_number(FILE* out, double v) {
+    if (isfinite(v))
+        fprintf(out, "%.9g", v);
+    else
+        fputs("null", out);
+}

@@ -1,0 +1,556 @@
+/*
+ * cli_compress.c - skinpack compress: replaces (compact) or accompanies (fallback) the
+ * JOINTS_n/WEIGHTS_n of every skinned primitive with SKINPACK_packed_skin. All compression is
+ * sp_compress_skin's; this file only moves arrays between the glTF document and the library.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_common.h"
+#include "commands.h"
+
+typedef struct compress_args {
+    const char* input;
+    const char* output;
+    sp_compress_options options;
+    double max_error; /* --max-error, 0 = unused */
+    int compact;
+    int json;
+    int meshlets; /* --meshlets: also write skin-aware meshlets */
+} compress_args;
+
+/* One primitive's outcome. Primitives with the same JOINTS_n/WEIGHTS_n accessors share the
+ * first one's result (shared_with >= 0) and are compressed once. */
+typedef struct compressed_primitive {
+    size_t mesh, primitive;
+    long shared_with;
+    gltf_skin_attributes attributes;
+    gltf_packed_skin packed;
+    sp_compressed_skin skin;
+    double input_bits_per_vertex;  /* JOINTS_n + WEIGHTS_n as stored in the input */
+    double output_bits_per_vertex; /* vertex words + tuple table as stored in the output */
+    int placeholder_joints, placeholder_weights; /* compact mode: data-less JOINTS_0/WEIGHTS_0 */
+    sp_meshlet_stats meshlet_stats; /* --meshlets */
+} compressed_primitive;
+
+static void compress_usage(FILE* out) {
+    fprintf(out,
+            "usage: skinpack compress IN -o OUT [options]\n"
+            "  --method oss|any|pot|cube|fixed   weight codec (default oss)\n"
+            "  --vertex-bits B      tuple index + weight code budget a vertex (default 32)\n"
+            "  --weight-bits B      weight code budget alone\n"
+            "  --max-error D        fewest bits whose proven max weight error is <= D\n"
+            "  --max-influences K   influences kept a vertex, 1..4 (default 4)\n"
+            "  --fallback           keep JOINTS_0/WEIGHTS_0, extension optional (default)\n"
+            "  --compact            remove them, extension required\n"
+            "  --meshlets           also store skin-aware meshlets (palettes, local tuple tables)\n"
+            "  --json               machine-readable report on stdout\n"
+            "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n");
+}
+
+static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
+    char* end = NULL;
+    unsigned long v = strtoul(s, &end, 10);
+    if (!s[0] || *end || v > max) return -1;
+    *out = (uint32_t)v;
+    return 0;
+}
+
+static int parse_args(int argc, char** argv, compress_args* args) {
+    memset(args, 0, sizeof(*args));
+    sp_compress_options_default(&args->options);
+    int budgets = 0;
+    for (int i = 1; i < argc; ++i) {
+        const char* a = argv[i];
+        const char* value = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-o") == 0 && value) {
+            args->output = value;
+            ++i;
+        } else if (strcmp(a, "--method") == 0 && value) {
+            args->options.method = sp_method_from_name(value);
+            if (args->options.method == SP_METHOD_COUNT) {
+                fprintf(stderr, "skinpack compress: unknown method '%s'\n", value);
+                return -1;
+            }
+            ++i;
+        } else if (strcmp(a, "--vertex-bits") == 0 && value) {
+            args->options.weight_bits = 0;
+            if (parse_uint(value, SP_MAX_VERTEX_BITS, &args->options.vertex_bits) || !args->options.vertex_bits) {
+                fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
+                return -1;
+            }
+            ++budgets;
+            ++i;
+        } else if (strcmp(a, "--weight-bits") == 0 && value) {
+            args->options.vertex_bits = 0;
+            if (parse_uint(value, SP_MAX_WEIGHT_BITS, &args->options.weight_bits)) {
+                fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
+                return -1;
+            }
+            ++budgets;
+            ++i;
+        } else if (strcmp(a, "--max-error") == 0 && value) {
+            char* end = NULL;
+            args->max_error = strtod(value, &end);
+            if (*end || !(args->max_error > 0 && args->max_error < 1)) {
+                fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
+                return -1;
+            }
+            args->options.vertex_bits = 0;
+            ++budgets;
+            ++i;
+        } else if (strcmp(a, "--max-influences") == 0 && value) {
+            if (parse_uint(value, SP_MAX_INFLUENCES, &args->options.max_influences) ||
+                !args->options.max_influences) {
+                fprintf(stderr, "skinpack compress: --max-influences must be 1..%d\n", SP_MAX_INFLUENCES);
+                return -1;
+            }
+            ++i;
+        } else if (strcmp(a, "--fallback") == 0) {
+            args->compact = 0;
+        } else if (strcmp(a, "--compact") == 0) {
+            args->compact = 1;
+        } else if (strcmp(a, "--json") == 0) {
+            args->json = 1;
+        } else if (strcmp(a, "--meshlets") == 0) {
+            args->meshlets = 1;
+        } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            compress_usage(stdout);
+            exit(0);
+        } else if (a[0] == '-' || args->input) {
+            fprintf(stderr, "skinpack compress: unexpected argument '%s'\n", a);
+            return -1;
+        } else {
+            args->input = a;
+        }
+    }
+    if (budgets > 1) {
+        fprintf(stderr, "skinpack compress: give at most one of --vertex-bits, --weight-bits, --max-error\n");
+        return -1;
+    }
+    if (!args->input || !args->output) {
+        compress_usage(stderr);
+        return -1;
+    }
+    return 0;
+}
+
+/* --max-error: the smallest weight-code width whose codec bound meets the target, for the K the
+ * library will use (min(max_influences, largest influence count)). */
+static int weight_bits_for_error(const compress_args* args, const uint16_t* joints, const float* weights,
+                                 size_t vertex_count, size_t stride, size_t joint_count, uint32_t* bits, char* err,
+                                 size_t err_size) {
+    uint32_t k = args->options.max_influences;
+    uint16_t* pj = malloc(vertex_count * k * sizeof(uint16_t));
+    float* pw = malloc(vertex_count * k * sizeof(float));
+    sp_prepare_stats stats;
+    memset(&stats, 0, sizeof(stats));
+    sp_result r = pj && pw ? sp_prepare_influences(joints, weights, vertex_count, stride, joint_count, k,
+                                                   args->options.sum_tolerance, pj, pw, NULL, &stats)
+                           : SP_ERR_INVALID_ARGUMENT;
+    free(pj);
+    free(pw);
+    if (r != SP_OK) {
+        snprintf(err, err_size, "vertex %zu: %s", stats.error_vertex, sp_result_string(r));
+        return -1;
+    }
+    uint32_t largest = 1;
+    for (uint32_t c = 1; c <= SP_MAX_INPUT_INFLUENCES; ++c)
+        if (stats.influence_histogram[c]) largest = c;
+    uint32_t k_used = largest < k ? largest : k;
+    for (uint32_t b = 0; b <= SP_MAX_WEIGHT_BITS; ++b) {
+        sp_codec codec;
+        if (sp_codec_from_bits(args->options.method, k_used, b, &codec) == SP_OK && codec.max_error <= args->max_error) {
+            *bits = b;
+            return 0;
+        }
+    }
+    snprintf(err, err_size, "no %s configuration reaches a max error of %g", sp_method_name(args->options.method),
+             args->max_error);
+    return -1;
+}
+
+/*
+ * --meshlets: sp_build_meshlets on the primitive's triangles with the weights and joints a
+ * decoder will see (the packed data decoded again), stored as the extension's "meshlets".
+ */
+static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t* words, const uint16_t* lut,
+                          char* err, size_t err_size) {
+    const sp_compressed_skin* s = &p->skin;
+    size_t index_count = 0, vertex_count = 0;
+    if (gltf_primitive_triangles(doc, p->mesh, p->primitive, &index_count, &vertex_count, err, err_size)) return -1;
+    if (vertex_count != s->vertex_count) {
+        snprintf(err, err_size, "POSITION has %zu vertices, JOINTS_0 %zu", vertex_count, s->vertex_count);
+        return -1;
+    }
+    cli_decoded_skin decoded;
+    if (cli_decode_packed_arrays(&p->packed, words, s->vertex_count, s->words_per_vertex, lut, s->lut_size, 0,
+                                 &decoded, err, err_size))
+        return -1;
+    uint32_t k = s->influences;
+    sp_meshlet_options options;
+    sp_meshlet_options_default(&options);
+    sp_meshlet_sizes sizes;
+    sp_meshlets_bound(index_count, vertex_count, k, &options, &sizes);
+    uint32_t* indices = malloc(index_count * sizeof(uint32_t));
+    float* positions = malloc(vertex_count * 3 * sizeof(float));
+    sp_meshlet_buffers out;
+    memset(&out, 0, sizeof(out));
+    out.meshlets = malloc(sizes.meshlets * sizeof(sp_meshlet));
+    out.vertices = malloc(sizes.vertices * sizeof(uint32_t));
+    out.vertex_tuples = malloc(sizes.vertices);
+    out.triangles = malloc(sizes.triangles * 3);
+    out.joints = malloc(sizes.joints * sizeof(uint16_t));
+    out.tuples = malloc(sizes.tuples * k);
+    out.capacity = sizes;
+    void* scratch = malloc(sizes.scratch_bytes ? sizes.scratch_bytes : 1);
+    uint32_t* offsets = NULL;
+    uint16_t* counts = NULL;
+    float* bounds = NULL;
+    float* cones = NULL;
+    int rc = -1;
+    sp_meshlet_stats* stats = &p->meshlet_stats;
+    if (!indices || !positions || !out.meshlets || !out.vertices || !out.vertex_tuples || !out.triangles ||
+        !out.joints || !out.tuples || !scratch) {
+        snprintf(err, err_size, "out of memory");
+        goto done;
+    }
+    if (gltf_read_triangles(doc, p->mesh, p->primitive, indices, positions, err, err_size)) goto done;
+    sp_result r = sp_build_meshlets(indices, index_count, positions, vertex_count, 3 * sizeof(float), decoded.joints,
+                                    decoded.weights, k, &options, &out, scratch, sizes.scratch_bytes, stats);
+    if (r != SP_OK) {
+        snprintf(err, err_size, "meshlets: %s (triangle %zu)", sp_result_string(r), stats->error_triangle);
+        goto done;
+    }
+    size_t n = stats->meshlet_count;
+    offsets = malloc(n * 4 * sizeof(uint32_t));
+    counts = malloc(n * 4 * sizeof(uint16_t));
+    bounds = malloc(n * 4 * sizeof(float));
+    cones = malloc(n * 4 * sizeof(float));
+    if (!offsets || !counts || !bounds || !cones) {
+        snprintf(err, err_size, "out of memory");
+        goto done;
+    }
+    for (size_t m = 0; m < n; ++m) {
+        const sp_meshlet* ml = &out.meshlets[m];
+        uint32_t o[4] = {ml->vertex_offset, ml->triangle_offset, ml->joint_offset, ml->tuple_offset};
+        uint16_t c[4] = {ml->vertex_count, ml->triangle_count, ml->joint_count, ml->tuple_count};
+        float b[4] = {ml->center[0], ml->center[1], ml->center[2], ml->radius};
+        float cone[4] = {ml->cone_axis[0], ml->cone_axis[1], ml->cone_axis[2], ml->cone_cutoff};
+        memcpy(offsets + 4 * m, o, sizeof(o));
+        memcpy(counts + 4 * m, c, sizeof(c));
+        memcpy(bounds + 4 * m, b, sizeof(b));
+        memcpy(cones + 4 * m, cone, sizeof(cone));
+    }
+    gltf_packed_meshlets* ml = &p->packed.meshlets;
+    ml->present = 1;
+    ml->offsets = gltf_add_accessor(doc, offsets, n, GLTF_UNSIGNED_INT, 4, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->counts = gltf_add_accessor(doc, counts, n, GLTF_UNSIGNED_SHORT, 4, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->bounds = gltf_add_accessor(doc, bounds, n, GLTF_FLOAT, 4, 0, 0);
+    ml->cones = gltf_add_accessor(doc, cones, n, GLTF_FLOAT, 4, 0, 0);
+    ml->vertices = gltf_add_accessor(doc, out.vertices, stats->vertex_count, GLTF_UNSIGNED_INT, 1, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->vertex_tuples = gltf_add_accessor(doc, out.vertex_tuples, stats->vertex_count, GLTF_UNSIGNED_BYTE, 1, 0,
+                                          GLTF_ACCESSOR_BOUNDS);
+    ml->triangles = gltf_add_accessor(doc, out.triangles, stats->triangle_count * 3, GLTF_UNSIGNED_BYTE, 1, 0,
+                                      GLTF_ACCESSOR_BOUNDS);
+    ml->joints = gltf_add_accessor(doc, out.joints, stats->joint_count, GLTF_UNSIGNED_SHORT, 1, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->tuples = gltf_add_accessor(doc, out.tuples, stats->tuple_count, GLTF_UNSIGNED_BYTE, (int)k, 0,
+                                   GLTF_ACCESSOR_BOUNDS);
+    ml->max_vertices = options.max_vertices;
+    ml->max_triangles = options.max_triangles;
+    ml->max_joints = options.max_joints;
+    rc = 0;
+done:
+    cli_decoded_skin_free(&decoded);
+    free(indices);
+    free(positions);
+    free(out.meshlets);
+    free(out.vertices);
+    free(out.vertex_tuples);
+    free(out.triangles);
+    free(out.joints);
+    free(out.tuples);
+    free(scratch);
+    free(offsets);
+    free(counts);
+    free(bounds);
+    free(cones);
+    return rc;
+}
+
+static int compress_primitive(gltf_doc* doc, const compress_args* args, compressed_primitive* p, char* err,
+                              size_t err_size) {
+    const gltf_skin_attributes* at = &p->attributes;
+    size_t vc = at->vertex_count, stride = 4 * at->sets;
+    uint16_t* joints = malloc(vc * stride * sizeof(uint16_t));
+    float* weights = malloc(vc * stride * sizeof(float));
+    uint32_t* words = malloc(vc * 2 * sizeof(uint32_t));
+    uint16_t* lut = malloc(vc * SP_MAX_INFLUENCES * sizeof(uint16_t));
+    size_t scratch_size = sp_compress_scratch_bound(vc, stride);
+    void* scratch = malloc(scratch_size ? scratch_size : 1);
+    int rc = -1;
+    if (!joints || !weights || !words || !lut || !scratch) {
+        snprintf(err, err_size, "out of memory");
+        goto done;
+    }
+    if (gltf_read_skin(doc, at, joints, weights, err, err_size)) goto done;
+
+    size_t joint_count = at->joint_count;
+    if (joint_count == 0) { /* no skinned node uses the mesh: the largest index bounds the joints */
+        for (size_t i = 0; i < vc * stride; ++i)
+            if (joints[i] >= joint_count) joint_count = (size_t)joints[i] + 1;
+        if (joint_count == 0) joint_count = 1;
+    }
+    sp_compress_options options = args->options;
+    if (args->max_error > 0 &&
+        weight_bits_for_error(args, joints, weights, vc, stride, joint_count, &options.weight_bits, err, err_size))
+        goto done;
+
+    sp_result r = sp_compress_skin(joints, weights, vc, stride, joint_count, &options, words, lut, NULL, NULL,
+                                   &p->skin, scratch, scratch_size);
+    if (r != SP_OK) {
+        if (r == SP_ERR_JOINT_OUT_OF_RANGE)
+            snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
+                     p->skin.prepare.error_joint, joint_count);
+        else
+            snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
+        goto done;
+    }
+
+    const sp_compressed_skin* s = &p->skin;
+    uint32_t k = s->influences;
+    memset(&p->packed, 0, sizeof(p->packed));
+    p->packed.influences = k;
+    p->packed.joint_count = (uint32_t)s->joint_count;
+    p->packed.method = s->codec.method;
+    p->packed.n = s->codec.n;
+    for (uint32_t i = 0; i + 1 < k && i < 3; ++i) p->packed.axis_samples[i] = s->codec.axis_samples[i];
+    p->packed.weight_bits = s->weight_bits;
+    p->packed.tuple_bits = s->tuple_bits;
+    p->packed.max_error = s->codec.max_error;
+    if (args->meshlets && build_meshlets(doc, p, words, lut, err, err_size)) goto done;
+
+    size_t lut_entries = s->lut_size * k;
+    int lut_type = GLTF_UNSIGNED_SHORT;
+    if (s->joint_bytes == 1) { /* narrow in place: u8 entries fit where the u16 were */
+        uint8_t* narrow = (uint8_t*)lut;
+        for (size_t i = 0; i < lut_entries; ++i) narrow[i] = (uint8_t)lut[i];
+        lut_type = GLTF_UNSIGNED_BYTE;
+    }
+    p->packed.vertices = gltf_add_accessor(doc, words, vc, GLTF_UNSIGNED_INT, (int)s->words_per_vertex, 0, 0);
+    /* no min/max on the words: bit fields, and glTF does not ask for them */
+    p->packed.tuple_table = gltf_add_accessor(doc, lut, s->lut_size, lut_type, (int)k, 0, GLTF_ACCESSOR_BOUNDS);
+    p->input_bits_per_vertex = at->stored_bits_per_vertex;
+    p->output_bits_per_vertex = 32.0 * s->words_per_vertex + s->lut_bits_per_vertex;
+    rc = 0;
+done:
+    free(joints);
+    free(weights);
+    free(words);
+    free(lut);
+    free(scratch);
+    return rc;
+}
+
+static int same_attributes(const gltf_skin_attributes* a, const gltf_skin_attributes* b) {
+    return a->sets == b->sets && memcmp(a->joints, b->joints, sizeof(a->joints)) == 0 &&
+           memcmp(a->weights, b->weights, sizeof(a->weights)) == 0;
+}
+
+static void print_json(const compress_args* args, const compressed_primitive* prims, size_t count,
+                       size_t input_bytes, size_t output_bytes) {
+    double in_bits = 0, out_bits = 0;
+    size_t vertices = 0;
+    printf("{\n  \"input\": ");
+    cli_json_string(stdout, args->input);
+    printf(",\n  \"output\": ");
+    cli_json_string(stdout, args->output);
+    printf(",\n  \"mode\": \"%s\",\n  \"primitives\": [", args->compact ? "compact" : "fallback");
+    for (size_t i = 0; i < count; ++i) {
+        const compressed_primitive* p = &prims[i];
+        const sp_compressed_skin* s = &p->skin;
+        if (p->shared_with < 0) {
+            in_bits += p->input_bits_per_vertex * (double)s->vertex_count;
+            out_bits += p->output_bits_per_vertex * (double)s->vertex_count;
+            vertices += s->vertex_count;
+        }
+        printf("%s\n    {\"mesh\": %zu, \"primitive\": %zu, \"shared_with\": %ld, \"vertices\": %zu, \"joints\": %zu, "
+               "\"influences\": %u, \"method\": \"%s\", \"n\": %llu, \"unique_tuples\": %zu, \"tuple_bits\": %u, "
+               "\"weight_bits\": %u, \"words_per_vertex\": %u, \"lut_bits_per_vertex\": ",
+               i ? "," : "", p->mesh, p->primitive, p->shared_with, s->vertex_count, s->joint_count, s->influences,
+               sp_method_name((sp_method)s->codec.method), (unsigned long long)s->codec.n, s->lut_size,
+               s->tuple_bits, s->weight_bits, s->words_per_vertex);
+        cli_json_number(stdout, s->lut_bits_per_vertex);
+        printf(", \"bits_per_vertex\": ");
+        cli_json_number(stdout, s->bits_per_vertex);
+        printf(", \"input_bits_per_vertex\": ");
+        cli_json_number(stdout, p->input_bits_per_vertex);
+        printf(", \"stored_bits_per_vertex\": ");
+        cli_json_number(stdout, p->output_bits_per_vertex);
+        printf(", \"max_error_bound\": ");
+        cli_json_number(stdout, s->codec.max_error);
+        printf(", \"max_weight_error\": ");
+        cli_json_number(stdout, s->quantization.max_error);
+        printf(", \"rms_weight_error\": ");
+        cli_json_number(stdout, s->quantization.rms_error);
+        printf(", \"max_pruning_error\": ");
+        cli_json_number(stdout, s->prepare.max_pruning_error);
+        printf(", \"pruned_vertices\": %zu, \"influence_histogram\": [", s->prepare.pruned_vertices);
+        for (int c = 0; c <= SP_MAX_INPUT_INFLUENCES; ++c)
+            printf("%s%zu", c ? ", " : "", s->prepare.influence_histogram[c]);
+        printf("]");
+        if (p->packed.meshlets.present) {
+            const sp_meshlet_stats* ms = &p->meshlet_stats;
+            printf(", \"meshlets\": {\"count\": %zu, \"max_vertices\": %u, \"max_triangles\": %u, \"mean_joints\": ",
+                   ms->meshlet_count, ms->max_vertices, ms->max_triangles);
+            cli_json_number(stdout, ms->mean_joints);
+            printf(", \"max_joints\": %u, \"global_tuple_bits\": %u, \"local_tuple_bits_mean\": ", ms->max_joints,
+                   s->tuple_bits);
+            cli_json_number(stdout, ms->local_tuple_bits_mean);
+            printf("}");
+        }
+        printf("}");
+    }
+    printf("\n  ],\n  \"vertices\": %zu,\n  \"input_bits_per_vertex\": ", vertices);
+    cli_json_number(stdout, vertices ? in_bits / (double)vertices : 0);
+    printf(",\n  \"output_bits_per_vertex\": ");
+    cli_json_number(stdout, vertices ? out_bits / (double)vertices : 0);
+    printf(",\n  \"input_bytes\": %zu,\n  \"output_bytes\": %zu\n}\n", input_bytes, output_bytes);
+}
+
+static void print_table(const compress_args* args, const compressed_primitive* prims, size_t count,
+                        size_t input_bytes, size_t output_bytes) {
+    printf("%-5s %-5s %8s %6s %2s %7s %-6s %10s %10s %6s %10s %10s\n", "mesh", "prim", "vertices", "joints", "K",
+           "tuples", "codec", "bits/v in", "bits/v out", "ratio", "max error", "bound");
+    for (size_t i = 0; i < count; ++i) {
+        const compressed_primitive* p = &prims[i];
+        const sp_compressed_skin* s = &p->skin;
+        if (p->shared_with >= 0) {
+            printf("%-5zu %-5zu (same attributes as row %ld)\n", p->mesh, p->primitive, p->shared_with + 1);
+            continue;
+        }
+        char codec[32];
+        snprintf(codec, sizeof(codec), "%s%u", sp_method_name((sp_method)s->codec.method), s->weight_bits);
+        printf("%-5zu %-5zu %8zu %6zu %2u %7zu %-6s %10.1f %10.1f %5.1fx %10.2e %10.2e\n", p->mesh, p->primitive,
+               s->vertex_count, s->joint_count, s->influences, s->lut_size, codec, p->input_bits_per_vertex,
+               p->output_bits_per_vertex, p->input_bits_per_vertex / p->output_bits_per_vertex,
+               s->quantization.max_error, s->codec.max_error);
+        if (p->packed.meshlets.present)
+            printf("            meshlets: %zu, up to %u vertices / %u triangles / %u joints, %.1f joints on average, "
+                   "tuple index %u -> %.2f bits\n", p->meshlet_stats.meshlet_count, p->meshlet_stats.max_vertices,
+                   p->meshlet_stats.max_triangles, p->meshlet_stats.max_joints, p->meshlet_stats.mean_joints,
+                   s->tuple_bits, p->meshlet_stats.local_tuple_bits_mean);
+    }
+    printf("%s mode; bits/v out = packed words + tuple table%s. file: %zu -> %zu bytes\n",
+           args->compact ? "compact" : "fallback",
+           args->compact ? "" : " (JOINTS_0/WEIGHTS_0 are kept as well)", input_bytes, output_bytes);
+}
+
+int skinpack_cmd_compress(int argc, char** argv) {
+    compress_args args;
+    if (parse_args(argc, argv, &args)) return 2;
+    char err[CLI_ERR_SIZE];
+    gltf_doc* doc = gltf_load_file(args.input, err, sizeof(err));
+    if (!doc) {
+        fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
+        return 1;
+    }
+    size_t capacity = 0, count = 0;
+    compressed_primitive* prims = NULL;
+    int rc = 1;
+    for (size_t m = 0; m < gltf_mesh_count(doc); ++m) {
+        for (size_t pi = 0; pi < gltf_primitive_count(doc, m); ++pi) {
+            gltf_packed_skin existing;
+            int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
+            if (has != 0) {
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi,
+                        has > 0 ? "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first" : err);
+                goto done;
+            }
+            gltf_skin_attributes attributes;
+            int skinned = gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err));
+            if (skinned < 0) {
+                fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
+                goto done;
+            }
+            if (!skinned) continue;
+            if (attributes.placeholder) {
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: JOINTS_0/WEIGHTS_0 have no data and "
+                        "there is no " GLTF_EXTENSION_NAME "\n", args.input, m, pi);
+                goto done;
+            }
+            if (count == capacity) {
+                capacity = capacity ? capacity * 2 : 16;
+                compressed_primitive* grown = realloc(prims, capacity * sizeof(*prims));
+                if (!grown) {
+                    fprintf(stderr, "skinpack compress: out of memory\n");
+                    goto done;
+                }
+                prims = grown;
+            }
+            compressed_primitive* p = &prims[count];
+            memset(p, 0, sizeof(*p));
+            p->mesh = m;
+            p->primitive = pi;
+            p->attributes = attributes;
+            p->shared_with = -1;
+            for (size_t j = 0; j < count; ++j)
+                if (prims[j].shared_with < 0 && same_attributes(&prims[j].attributes, &attributes) &&
+                    (!args.meshlets || gltf_same_geometry(doc, prims[j].mesh, prims[j].primitive, m, pi))) {
+                    p->shared_with = (long)j;
+                    p->skin = prims[j].skin;
+                    p->packed = prims[j].packed;
+                    p->input_bits_per_vertex = prims[j].input_bits_per_vertex;
+                    p->output_bits_per_vertex = prims[j].output_bits_per_vertex;
+                    p->meshlet_stats = prims[j].meshlet_stats;
+                    break;
+                }
+            if (p->shared_with < 0 && compress_primitive(doc, &args, p, err, sizeof(err))) {
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi, err);
+                goto done;
+            }
+            ++count;
+        }
+    }
+    /* Edit the primitives only after every one compressed: accessors are shared. Compact mode
+     * keeps JOINTS_0/WEIGHTS_0 on accessors without data, as KHR_draco_mesh_compression does:
+     * the skin still has a skinned mesh (the Khronos validator insists) and a decoder knows
+     * which attributes the extension supplies. */
+    for (size_t i = 0; i < count; ++i) {
+        compressed_primitive* p = &prims[i];
+        gltf_set_packed(doc, p->mesh, p->primitive, &p->packed);
+        if (!args.compact) continue;
+        if (p->shared_with < 0) {
+            p->placeholder_joints = gltf_add_accessor(doc, NULL, p->skin.vertex_count,
+                                                      p->skin.joint_bytes == 1 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT,
+                                                      4, 0, 0);
+            p->placeholder_weights = gltf_add_accessor(doc, NULL, p->skin.vertex_count, GLTF_FLOAT, 4, 0, 0);
+        } else {
+            p->placeholder_joints = prims[p->shared_with].placeholder_joints;
+            p->placeholder_weights = prims[p->shared_with].placeholder_weights;
+        }
+        gltf_set_skin_attributes(doc, p->mesh, p->primitive, p->placeholder_joints, p->placeholder_weights);
+    }
+    if (count) gltf_declare_extension(doc, 1, args.compact);
+    if (count == 0) fprintf(stderr, "skinpack compress: %s: no skinned primitives; the file is copied\n", args.input);
+    if (args.compact && gltf_collect_garbage(doc, err, sizeof(err))) {
+        fprintf(stderr, "skinpack compress: %s: %s (use --fallback)\n", args.input, err);
+        goto done;
+    }
+    size_t output_bytes = 0;
+    if (gltf_write_file(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &output_bytes, err,
+                        sizeof(err))) {
+        fprintf(stderr, "skinpack compress: %s\n", err);
+        goto done;
+    }
+    if (args.json)
+        print_json(&args, prims, count, cli_file_size(args.input), output_bytes);
+    else
+        print_table(&args, prims, count, cli_file_size(args.input), output_bytes);
+    rc = 0;
+done:
+    free(prims);
+    gltf_free(doc);
+    return rc;
+}

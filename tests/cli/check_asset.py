@@ -1,0 +1,254 @@
+"""End-to-end checks of the skinpack CLI on one glTF asset.
+
+    python3 check_asset.py CHECK --skinpack BIN --node NODE --validator tools/validate.mjs \
+        --work DIR ASSET [compress options...]
+
+CHECK is one of
+  validate   compact and fallback outputs and the decompressed file pass the Khronos validator
+             with 0 errors (and the input itself does)
+  roundtrip  compress -> decompress keeps every joint and keeps every weight within the codec's
+             bound (maxError) of the input prepared as docs/format.md says; the observed error
+             matches what compress --json reported; both modes, .glb and .gltf output
+  info       info --json on the compressed file agrees with compress --json, and on the input
+             with compress's influence histogram
+  meshlets   compress --meshlets: every source triangle is in exactly one meshlet (same winding),
+             every meshlet vertex's palette joints are the decoded joints of its source vertex,
+             limits hold, and the stored counts match compress --json
+Anything after ASSET is passed to skinpack compress (e.g. --method pot --weight-bits 20).
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_read  # noqa: E402
+
+FLOAT_SLACK = 2e-6  # float32 rounding of decoded weights and of the reference
+
+
+def run(cmd):
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise SystemExit("FAILED (%d): %s\n%s%s" % (result.returncode, " ".join(cmd), result.stdout, result.stderr))
+    return result.stdout
+
+
+# What issue 3 asks compress --json to report, at least.
+REQUIRED_PRIMITIVE_KEYS = ["mesh", "primitive", "vertices", "joints", "unique_tuples", "tuple_bits", "weight_bits",
+                           "lut_bits_per_vertex", "bits_per_vertex", "max_weight_error", "rms_weight_error",
+                           "max_pruning_error"]
+REQUIRED_TOP_KEYS = ["primitives", "input_bits_per_vertex", "output_bits_per_vertex", "input_bytes", "output_bytes"]
+
+
+def compress(args, mode, out, extra):
+    report = json.loads(run([args.skinpack, "compress", args.asset, "-o", out, "--" + mode, "--json"] + extra))
+    if not report["primitives"]:
+        raise SystemExit("no skinned primitive compressed in %s" % args.asset)
+    missing = [k for k in REQUIRED_TOP_KEYS if k not in report]
+    missing += [k for p in report["primitives"] for k in REQUIRED_PRIMITIVE_KEYS if k not in p]
+    if missing:
+        raise SystemExit("compress --json lacks %s" % sorted(set(missing)))
+    if report["output_bytes"] != os.path.getsize(out) or report["input_bytes"] != os.path.getsize(args.asset):
+        raise SystemExit("compress --json byte counts differ from the files")
+    return report
+
+
+def outputs(args, extra):
+    name = os.path.splitext(os.path.basename(args.asset))[0]
+    tag = "_".join(a.strip("-") for a in extra) or "default"
+    base = os.path.join(args.work, "%s_%s" % (name, tag))
+    return base
+
+
+def check_validate(args, extra):
+    base = outputs(args, extra)
+    files = [args.asset]
+    for mode in ("compact", "fallback"):
+        compress(args, mode, base + "_%s.glb" % mode, extra)
+        run([args.skinpack, "decompress", base + "_%s.glb" % mode, "-o", base + "_%s_decoded.glb" % mode])
+        files += [base + "_%s.glb" % mode, base + "_%s_decoded.glb" % mode]
+    compress(args, "compact", base + "_compact.gltf", extra)
+    files.append(base + "_compact.gltf")
+    print(run([args.node, args.validator] + files))
+    for f in files[1:]:
+        doc = gltf_read.Gltf(f)
+        used = doc.json.get("extensionsUsed", [])
+        required = doc.json.get("extensionsRequired", [])
+        packed = any(gltf_read.EXTENSION in p.get("extensions", {}) for _, _, p in doc.primitives())
+        decoded = f.endswith("_decoded.glb")
+        if decoded and (packed or gltf_read.EXTENSION in used):
+            raise SystemExit("%s: decompressed file still uses the extension" % f)
+        if not decoded:
+            compact = "_compact" in f
+            if not packed or gltf_read.EXTENSION not in used or (gltf_read.EXTENSION in required) != compact:
+                raise SystemExit("%s: extension not declared as %s mode requires" % (f, "compact" if compact else
+                                                                                     "fallback"))
+
+
+def check_roundtrip(args, extra):
+    base = outputs(args, extra)
+    original = gltf_read.Gltf(args.asset)
+    for mode, ext in (("compact", ".glb"), ("fallback", ".glb"), ("compact", ".gltf")):
+        packed_path = base + "_rt_%s%s" % (mode, ext)
+        decoded_path = base + "_rt_%s_decoded%s" % (mode, ext)
+        report = compress(args, mode, packed_path, extra)
+        run([args.skinpack, "decompress", packed_path, "-o", decoded_path])
+        packed = gltf_read.Gltf(packed_path)
+        decoded = gltf_read.Gltf(decoded_path)
+        by_primitive = {(r["mesh"], r["primitive"]): r for r in report["primitives"]}
+        # Primitives that shared JOINTS_0/WEIGHTS_0 share the packed accessors (compressed once).
+        shared = {}
+        for m, p, prim in original.primitives():
+            if "JOINTS_0" in prim["attributes"]:
+                key = (prim["attributes"]["JOINTS_0"], prim["attributes"]["WEIGHTS_0"])
+                ext = packed.json["meshes"][m]["primitives"][p]["extensions"][gltf_read.EXTENSION]
+                if shared.setdefault(key, (ext["vertices"], ext["tupleTable"])) != (ext["vertices"], ext["tupleTable"]):
+                    raise SystemExit("mesh %d primitive %d: shared attributes were compressed twice" % (m, p))
+        checked = 0
+        for m, p, prim in original.primitives():
+            reference = original.influences(prim)
+            if reference is None:
+                continue
+            ext = packed.json["meshes"][m]["primitives"][p]["extensions"][gltf_read.EXTENSION]
+            k, bound = ext["influences"], ext["maxError"]
+            got = decoded.influences(decoded.json["meshes"][m]["primitives"][p])
+            if got is None or len(got) != len(reference):
+                raise SystemExit("%s mesh %d primitive %d: decoded vertex count differs" % (decoded_path, m, p))
+            worst = 0.0
+            for v, (ref, dec) in enumerate(zip(reference, got)):
+                expected = gltf_read.prepare(ref, k)
+                for j in dec:
+                    if j not in expected:
+                        raise SystemExit("%s mesh %d primitive %d vertex %d: joint %d was not an influence (had %s)"
+                                         % (decoded_path, m, p, v, j, sorted(expected)))
+                for j, w in expected.items():
+                    if w > bound + FLOAT_SLACK and j not in dec:
+                        raise SystemExit("%s mesh %d primitive %d vertex %d: joint %d (weight %g) lost"
+                                         % (decoded_path, m, p, v, j, w))
+                    error = abs(w - dec.get(j, 0.0))
+                    if error > bound + FLOAT_SLACK:
+                        raise SystemExit("%s mesh %d primitive %d vertex %d: joint %d weight %g decoded as %g, "
+                                         "error %g > bound %g" % (decoded_path, m, p, v, j, w, dec.get(j, 0.0),
+                                                                  error, bound))
+                    worst = max(worst, error)
+            reported = by_primitive[(m, p)]["max_weight_error"]
+            if abs(worst - reported) > 1e-5:
+                raise SystemExit("%s mesh %d primitive %d: observed max error %g, compress reported %g"
+                                 % (packed_path, m, p, worst, reported))
+            print("%s mesh %d prim %d: %d vertices, K=%d, max error %.3g <= bound %.3g" %
+                  (os.path.basename(packed_path), m, p, len(reference), k, worst, bound))
+            checked += 1
+        if checked == 0:
+            raise SystemExit("no skinned primitive checked")
+
+
+AGREE = ["vertices", "joints", "influences", "unique_tuples", "tuple_bits", "weight_bits", "method", "n"]
+AGREE_FLOAT = ["lut_bits_per_vertex", "bits_per_vertex", "max_error_bound"]
+
+
+def check_info(args, extra):
+    base = outputs(args, extra)
+    info_in = json.loads(run([args.skinpack, "info", args.asset, "--json"]))
+    input_rows = {(r["mesh"], r["primitive"]): r for r in info_in["primitives"]}
+    for mode in ("compact", "fallback"):
+        path = base + "_info_%s.glb" % mode
+        report = compress(args, mode, path, extra)
+        info = json.loads(run([args.skinpack, "info", path, "--json"]))
+        rows = {(r["mesh"], r["primitive"]): r for r in info["primitives"]}
+        if len(rows) != len(report["primitives"]):
+            raise SystemExit("info lists %d primitives, compress %d" % (len(rows), len(report["primitives"])))
+        for c in report["primitives"]:
+            key = (c["mesh"], c["primitive"])
+            i = rows[key]
+            for field in AGREE:
+                if i[field] != c[field]:
+                    raise SystemExit("%s %s: info %s=%r, compress %r" % (path, key, field, i[field], c[field]))
+            for field in AGREE_FLOAT:
+                if abs(i[field] - c[field]) > 1e-9 * max(1.0, abs(c[field])):
+                    raise SystemExit("%s %s: info %s=%r, compress %r" % (path, key, field, i[field], c[field]))
+            if input_rows[key]["influence_histogram"] != c["influence_histogram"]:
+                raise SystemExit("%s: influence histogram of the input differs between info and compress" % (key,))
+            if input_rows[key]["stored_bits_per_vertex"] != c["input_bits_per_vertex"]:
+                raise SystemExit("%s: input bits per vertex differ between info and compress" % (key,))
+            if ("meshlets" in c) != ("meshlets" in i) or ("meshlets" in c and any(
+                    abs(i["meshlets"][f] - c["meshlets"][f]) > 1e-9 * max(1.0, abs(c["meshlets"][f]))
+                    for f in c["meshlets"])):
+                raise SystemExit("%s: meshlets differ: info %r, compress %r" % (key, i.get("meshlets"),
+                                                                             c.get("meshlets")))
+            if mode == "fallback" and not (i["fallback_max_difference"] <= c["max_error_bound"] + FLOAT_SLACK):
+                raise SystemExit("%s: packed data and fallback attributes differ by %r" %
+                                 (key, i["fallback_max_difference"]))
+        print("%s: info agrees with compress on %d primitive(s)" % (os.path.basename(path), len(rows)))
+
+
+def canonical(triangle):
+    """The rotation of a triangle that starts with its smallest index (keeps the winding)."""
+    i = triangle.index(min(triangle))
+    return tuple(triangle[i:] + triangle[:i])
+
+
+def check_meshlets(args, extra):
+    base = outputs(args, extra)
+    path = base + "_meshlets.glb"
+    decoded_path = base + "_meshlets_decoded.glb"
+    report = compress(args, "compact", path, extra + ["--meshlets"])
+    run([args.skinpack, "decompress", path, "-o", decoded_path])
+    original, packed, decoded = gltf_read.Gltf(args.asset), gltf_read.Gltf(path), gltf_read.Gltf(decoded_path)
+    rows = {(r["mesh"], r["primitive"]): r for r in report["primitives"]}
+    for m, p, prim in original.primitives():
+        if "JOINTS_0" not in prim["attributes"]:
+            continue
+        ext = packed.json["meshes"][m]["primitives"][p]["extensions"][gltf_read.EXTENSION]
+        ml = ext["meshlets"]
+        k = ext["influences"]
+        get = lambda name: packed.accessor(ml[name])  # noqa: E731
+        offsets, counts, vertices, vtuples = get("offsets"), get("counts"), get("vertices"), get("vertexTuples")
+        triangles, joints, tuples = get("triangles"), get("joints"), get("tuples")
+        dprim = decoded.json["meshes"][m]["primitives"][p]["attributes"]
+        djoints, dweights = decoded.accessor(dprim["JOINTS_0"]), decoded.accessor(dprim["WEIGHTS_0"])
+        if "indices" in prim:
+            flat = [i[0] for i in original.accessor(prim["indices"])]
+        else:
+            flat = list(range(len(djoints)))
+        source = sorted(canonical(flat[i:i + 3]) for i in range(0, len(flat), 3))
+        seen = []
+        for index, ((vo, to, jo, uo), (vc, tc, jc, uc)) in enumerate(zip(offsets, counts)):
+            if vc > ml["maxVertices"] or tc > ml["maxTriangles"] or jc > ml["maxJoints"]:
+                raise SystemExit("meshlet %d breaks its limits" % index)
+            for t in range(tc):
+                local = [triangles[3 * (to + t) + c][0] for c in range(3)]
+                seen.append(canonical([vertices[vo + i][0] for i in local]))
+            for e in range(vo, vo + vc):
+                v = vertices[e][0]
+                tuple_entry = tuples[uo + vtuples[e][0]]
+                for s in range(k):
+                    if dweights[v][s] > 0 and joints[jo + tuple_entry[s]][0] != djoints[v][s]:
+                        raise SystemExit("meshlet %d vertex %d slot %d: palette joint %d, decoded joint %d" %
+                                         (index, v, s, joints[jo + tuple_entry[s]][0], djoints[v][s]))
+        if sorted(seen) != source:
+            raise SystemExit("mesh %d primitive %d: meshlet triangles differ from the source triangles" % (m, p))
+        stats = rows[(m, p)]["meshlets"]
+        if stats["count"] != len(offsets) or stats["max_joints"] != max(c[2] for c in counts):
+            raise SystemExit("mesh %d primitive %d: compress --json meshlets disagree with the file" % (m, p))
+        print("mesh %d prim %d: %d triangles in %d meshlets, palettes and local tuples match the decoded joints"
+              % (m, p, len(source), len(offsets)))
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("check", choices=["validate", "roundtrip", "info", "meshlets"])
+    parser.add_argument("--skinpack", required=True)
+    parser.add_argument("--node", default="node")
+    parser.add_argument("--validator", required=True)
+    parser.add_argument("--work", required=True)
+    parser.add_argument("asset")
+    args, extra = parser.parse_known_args()
+    os.makedirs(args.work, exist_ok=True)
+    {"validate": check_validate, "roundtrip": check_roundtrip, "info": check_info,
+     "meshlets": check_meshlets}[args.check](args, extra)
+    print("OK")
+
+
+main()

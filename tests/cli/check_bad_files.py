@@ -1,0 +1,265 @@
+"""Broken inputs get a clear error, exit status 1 and no output file (issue 3, item 3).
+
+    python3 check_bad_files.py --skinpack BIN --work DIR ASSET.glb
+
+From ASSET (a skinned .glb with float weights, e.g. Fox.glb) it makes one broken file per case,
+standard and packed, and runs the commands that read it. A case passes when the command exits
+with 1 (a crash is a signal or another code), prints "skinpack ...: <reason>" on stderr where
+reason contains the expected words, and leaves neither OUT nor a temporary file behind.
+"""
+import argparse
+import copy
+import glob
+import os
+import struct
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_read  # noqa: E402
+
+EXT = gltf_read.EXTENSION
+
+
+def load(path):
+    doc = gltf_read.Gltf(path)
+    return doc.json, bytearray(doc.bin)
+
+
+def skinned(document):
+    for mesh in document["meshes"]:
+        for prim in mesh["primitives"]:
+            if "JOINTS_0" in prim["attributes"] or EXT in prim.get("extensions", {}):
+                return prim
+    raise SystemExit("no skinned primitive")
+
+
+def element_offset(document, accessor, index):
+    a = document["accessors"][accessor]
+    view = document["bufferViews"][a["bufferView"]]
+    size = {5121: 1, 5123: 2, 5125: 4, 5126: 4}[a["componentType"]] * gltf_read.TYPE[a["type"]]
+    return view.get("byteOffset", 0) + a.get("byteOffset", 0) + index * view.get("byteStride", size)
+
+
+# ---- standard (JOINTS_0/WEIGHTS_0) cases: (name, expected words, edit(document, bin)) ----
+
+def weights_value(value):
+    def edit(d, b):
+        acc = skinned(d)["attributes"]["WEIGHTS_0"]
+        if d["accessors"][acc]["componentType"] != 5126:
+            raise SystemExit("the asset needs FLOAT weights for this case")
+        struct.pack_into("<f", b, element_offset(d, acc, 5), value)
+    return edit
+
+
+def drop_weights(d, b):
+    del skinned(d)["attributes"]["WEIGHTS_0"]
+
+
+def joint_past_skin(d, b):
+    acc = skinned(d)["attributes"]["JOINTS_0"]
+    ctype = d["accessors"][acc]["componentType"]
+    struct.pack_into("<H" if ctype == 5123 else "<B", b, element_offset(d, acc, 7), len(d["skins"][0]["joints"]))
+
+
+def accessor_past_view(d, b):
+    d["accessors"][skinned(d)["attributes"]["JOINTS_0"]]["count"] *= 3
+
+
+def accessor_missing(d, b):
+    skinned(d)["attributes"]["JOINTS_0"] = len(d["accessors"]) + 5
+
+
+def view_past_buffer(d, b):
+    acc = d["accessors"][skinned(d)["attributes"]["WEIGHTS_0"]]
+    d["bufferViews"][acc["bufferView"]]["byteOffset"] = len(b) - 8
+
+
+def requires_meshopt(d, b):
+    d.setdefault("extensionsUsed", []).append("EXT_meshopt_compression")
+    d.setdefault("extensionsRequired", []).append("EXT_meshopt_compression")
+
+
+STANDARD = [
+    ("requires-meshopt", "EXT_meshopt_compression", requires_meshopt),
+    ("nan-weight", "finite", weights_value(float("nan"))),
+    ("negative-weight", "negative", weights_value(-0.25)),
+    ("joints-without-weights", "without WEIGHTS_0", drop_weights),
+    ("joint-past-skin", "past the skin", joint_past_skin),
+    ("accessor-past-view", "past the end", accessor_past_view),
+    ("accessor-missing", "does not exist", accessor_missing),
+    ("view-past-buffer", "outside buffer", view_past_buffer),
+]
+
+
+# ---- packed (SKINPACK_packed_skin) cases ----
+
+def ext_of(d):
+    return skinned(d)["extensions"][EXT]
+
+
+def set_field(name, value):
+    def edit(d, b):
+        ext_of(d)[name] = value
+    return edit
+
+
+def word_fields(tuple_value=None, code_value=None):
+    def edit(d, b):
+        e = ext_of(d)
+        if e["tupleBits"] + e["weightBits"] > 32:
+            raise SystemExit("the asset's packed words must be one u32 for this case")
+        offset = element_offset(d, e["vertices"], 3)
+        word = struct.unpack_from("<I", b, offset)[0]
+        mask = (1 << e["weightBits"]) - 1
+        if code_value is not None:
+            word = (word & ~mask) | code_value(e)
+        if tuple_value is not None:
+            word = (word & mask) | (tuple_value(e) << e["weightBits"])
+        struct.pack_into("<I", b, offset, word & 0xffffffff)
+    return edit
+
+
+def lut_joint(d, b):
+    e = ext_of(d)
+    acc = d["accessors"][e["tupleTable"]]
+    fmt = "<B" if acc["componentType"] == 5121 else "<H"
+    struct.pack_into(fmt, b, element_offset(d, e["tupleTable"], 0), e["jointCount"])
+
+
+def oss_code_count(n):
+    """T(N) of docs/format.md, for K = 4."""
+    def u(k):
+        return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) // 9
+    return u((n + 1) // 2)
+
+
+def lut_size(d):
+    return d["accessors"][ext_of(d)["tupleTable"]]["count"]
+
+
+PACKED = [
+    ("code-past-count", "code", word_fields(code_value=lambda e: oss_code_count(e["n"]))),
+    ("tuple-past-table", "tuple", word_fields(tuple_value=lambda e: (1 << e["tupleBits"]) - 1)),
+    ("lut-joint-past-count", "joint", lut_joint),
+    ("weight-bits-65", "weightBits", set_field("weightBits", 65)),
+    ("tuple-bits-40", "tupleBits", set_field("tupleBits", 40)),
+    ("weight-bits-mismatch", "weightBits", set_field("weightBits", 20)),
+    ("tuple-bits-mismatch", "tupleBits", set_field("tupleBits", 3)),
+    ("unknown-method", "method", set_field("method", "zip")),
+    ("influences-5", "influences", set_field("influences", 5)),
+    ("n-zero", "codec", set_field("n", 0)),
+    ("vertices-missing", "does not exist", set_field("vertices", 100000)),
+    ("joint-count-past-skin", "jointCount", set_field("jointCount", 200)),
+    ("extension-not-an-object", "no data", lambda d, b: skinned(d)["extensions"].__setitem__(EXT, [1, 2])),
+]
+
+
+def meshlet_byte(name, value, index=0):
+    def edit(d, b):
+        acc = ext_of(d)["meshlets"][name]
+        b[element_offset(d, acc, index)] = value
+    return edit
+
+
+def meshlet_offsets_past_end(d, b):
+    acc = ext_of(d)["meshlets"]["offsets"]
+    struct.pack_into("<I", b, element_offset(d, acc, 0), 1 << 30)
+
+
+MESHLETS = [
+    ("triangle-past-vertices", "triangle index", meshlet_byte("triangles", 255)),
+    ("tuple-past-palette", "past the palette", meshlet_byte("tuples", 250)),
+    ("offsets-past-arrays", "out of range", meshlet_offsets_past_end),
+    ("meshlets-not-an-object", "must be an object", lambda d, b: ext_of(d).__setitem__("meshlets", 3)),
+]
+
+
+def expect_failure(cmd, words, out, work):
+    if out and os.path.exists(out):
+        os.remove(out)
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    problems = []
+    if result.returncode != 1:
+        problems.append("exit status %d (want 1)" % result.returncode)
+    if not result.stderr.startswith("skinpack") or words.lower() not in result.stderr.lower():
+        problems.append("stderr %r lacks %r" % (result.stderr.strip(), words))
+    if out and os.path.exists(out):
+        problems.append("output %s was written" % out)
+    leftovers = glob.glob(os.path.join(work, "*.tmp-*"))
+    if leftovers:
+        problems.append("temporary files left: %s" % leftovers)
+    status = "ok  " if not problems else "FAIL"
+    print("%s %s -> %s" % (status, " ".join(os.path.basename(c) for c in cmd[1:3]), result.stderr.strip()))
+    return problems
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--skinpack", required=True)
+    parser.add_argument("--work", required=True)
+    parser.add_argument("asset")
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    out = os.path.join(args.work, "out.glb")
+    failures = []
+
+    document, binary = load(args.asset)
+    packed_path = os.path.join(args.work, "packed.glb")
+    subprocess.run([args.skinpack, "compress", args.asset, "-o", packed_path, "--compact", "--vertex-bits", "32"],
+                   check=True, capture_output=True)
+    packed_document, packed_binary = load(packed_path)
+
+    meshlets_path = os.path.join(args.work, "packed_meshlets.glb")
+    subprocess.run([args.skinpack, "compress", args.asset, "-o", meshlets_path, "--compact", "--meshlets"],
+                   check=True, capture_output=True)
+    meshlets_document, meshlets_binary = load(meshlets_path)
+
+    cases = [("standard", c, document, binary) for c in STANDARD] + [("packed", c, packed_document, packed_binary)
+                                                                      for c in PACKED]
+    cases += [("meshlets", c, meshlets_document, meshlets_binary) for c in MESHLETS]
+    for kind, (name, words, edit), doc, data in cases:
+        d, b = copy.deepcopy(doc), bytearray(data)
+        edit(d, b)
+        path = os.path.join(args.work, "%s-%s.glb" % (kind, name))
+        gltf_read.write_glb(d, b, path)
+        commands = [[args.skinpack, "info", path]]
+        if kind != "meshlets":  # decompress drops meshlets without reading them
+            commands.append([args.skinpack, "compress" if kind == "standard" else "decompress", path, "-o", out])
+        for cmd in commands:
+            problems = expect_failure(cmd, words, out if "-o" in cmd else None, args.work)
+            failures += ["%s: %s" % (name, p) for p in problems]
+
+    # Files that are not glTF at all, or cut short.
+    with open(args.asset, "rb") as f:
+        whole = f.read()
+    for name, data, words in [("truncated", whole[: len(whole) // 2], "glTF"), ("empty", b"", "too small"),
+                              ("garbage", b"\x00not gltf at all" * 10, "glTF")]:
+        path = os.path.join(args.work, "%s.glb" % name)
+        with open(path, "wb") as f:
+            f.write(data)
+        for cmd in ([args.skinpack, "info", path], [args.skinpack, "compress", path, "-o", out]):
+            failures += ["%s: %s" % (name, p) for p in expect_failure(cmd, words, out, args.work)]
+
+    # A .gltf whose buffer file is missing.
+    missing = copy.deepcopy(document)
+    missing["buffers"] = [{"byteLength": len(binary), "uri": "missing.bin"}]
+    path = os.path.join(args.work, "missing-buffer.gltf")
+    with open(path, "w") as f:
+        import json
+        json.dump(missing, f)
+    failures += ["missing-buffer: %s" % p for p in
+                 expect_failure([args.skinpack, "compress", path, "-o", out], "missing.bin", out, args.work)]
+
+    # An output folder that does not exist: error, and nothing half-written anywhere.
+    bad_out = os.path.join(args.work, "no-such-dir", "out.glb")
+    failures += ["unwritable: %s" % p for p in
+                 expect_failure([args.skinpack, "compress", args.asset, "-o", bad_out], "cannot", bad_out, args.work)]
+
+    if failures:
+        print("\n".join(failures))
+        raise SystemExit("%d problem(s)" % len(failures))
+    print("OK")
+
+
+main()
