@@ -12,13 +12,17 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 # Debian packages the build, the tests and the benchmarks need.
 PACKAGES=(cmake make gcc g++ clang libclang-rt-14-dev python3-numpy blender libtinygltf-dev
           glslang-tools mesa-vulkan-drivers libvulkan-dev vulkan-tools libmeshoptimizer-dev
-          gltfpack zlib1g-dev libzstd-dev zstd nodejs npm)
+          gltfpack zlib1g-dev libzstd-dev zstd)
 
 install_packages() {
   local missing=()
   for p in "${PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
+  # Node.js may come from another source than Debian (its npm is bundled): only add Debian's
+  # packages when there is no node/npm at all.
+  command -v node >/dev/null 2>&1 || missing+=(nodejs)
+  command -v npm >/dev/null 2>&1 || missing+=(npm)
   if [ ${#missing[@]} -gt 0 ]; then
     echo "build.sh: installing ${missing[*]}"
     local sudo=""
