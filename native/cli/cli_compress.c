@@ -45,6 +45,7 @@ static void compress_usage(FILE* out) {
             "  --fallback           keep JOINTS_0/WEIGHTS_0, extension optional (default)\n"
             "  --compact            remove them, extension required\n"
             "  --meshlets           also store skin-aware meshlets (palettes, local tuple tables)\n"
+            "  --exact-tuples       no don't-care sharing: zero-weight slots keep their joints\n"
             "  --json               machine-readable report on stdout\n"
             "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n");
 }
@@ -115,6 +116,8 @@ static int parse_args(int argc, char** argv, compress_args* args) {
             args->json = 1;
         } else if (strcmp(a, "--meshlets") == 0) {
             args->meshlets = 1;
+        } else if (strcmp(a, "--exact-tuples") == 0) {
+            args->options.merge_dont_care = 0;
         } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             compress_usage(stdout);
             exit(0);
