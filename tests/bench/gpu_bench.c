@@ -186,49 +186,19 @@ static void build_meshlets(vkx_context* ctx, bench_mesh* m, const uint16_t* join
             joints_k[v * k + slot] = joints4[v * 4 + slot];
             weights_k[v * k + slot] = weights4[v * 4 + slot];
         }
-    sp_meshlet_options meshlet_options;
-    sp_meshlet_options_default(&meshlet_options); /* 64 vertices, 124 triangles: skin.mesh's limits */
-    sp_meshlet_sizes sizes;
-    sp_meshlets_bound((size_t)s->triangle_count * 3, s->vertex_count, k, &meshlet_options, &sizes);
-    sp_meshlet_buffers out = {
-        .meshlets = malloc(sizes.meshlets * sizeof(sp_meshlet)),
-        .vertices = malloc(sizes.vertices * sizeof(uint32_t)),
-        .vertex_tuples = malloc(sizes.vertices),
-        .triangles = malloc(sizes.triangles * 3),
-        .joints = malloc(sizes.joints * sizeof(uint16_t)),
-        .tuples = malloc(sizes.tuples * k),
-        .capacity = sizes,
-    };
-    void* scratch = malloc(sizes.scratch_bytes);
-    sp_meshlet_stats stats;
-    sp_result result = sp_build_meshlets(s->indices, (size_t)s->triangle_count * 3, s->positions, s->vertex_count,
-                                         3 * sizeof(float), joints_k, weights_k, k, &meshlet_options, &out, scratch,
-                                         sizes.scratch_bytes, &stats);
+    sp_gpu_meshlets built; /* skin.mesh's limits */
+    sp_result result = sp_gpu_meshlets_build(s->indices, (size_t)s->triangle_count * 3, s->positions, s->vertex_count,
+                                             3 * sizeof(float), joints_k, weights_k, k, &built);
     if (result != SP_OK) {
         fprintf(stderr, "%s: sp_build_meshlets: %s (mesh-shader path skipped for it)\n", s->name, sp_result_string(result));
     } else {
-        size_t bytes[5] = {stats.vertex_count * 4, stats.vertex_count, stats.triangle_count * 3, stats.joint_count * 2,
-                           stats.tuple_count * k};
-        const void* arrays[5] = {out.vertices, out.vertex_tuples, out.triangles, out.joints, out.tuples};
-        size_t total_words = 0;
-        for (int a = 0; a < 5; ++a) {
-            m->meshlet_offsets[a] = (uint32_t)total_words;
-            total_words += (bytes[a] + 3) / 4;
-        }
-        uint32_t* data = calloc(total_words + 1, sizeof(uint32_t));
-        for (int a = 0; a < 5; ++a) memcpy(data + m->meshlet_offsets[a], arrays[a], bytes[a]);
-        m->meshlet_data = vkx_upload(ctx, data, total_words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-        m->meshlets = vkx_upload(ctx, out.meshlets, stats.meshlet_count * sizeof(sp_meshlet), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-        m->meshlet_count = (uint32_t)stats.meshlet_count;
-        free(data);
+        memcpy(m->meshlet_offsets, built.offsets, sizeof(built.offsets));
+        m->meshlet_data = vkx_upload(ctx, built.data, built.data_words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        m->meshlets = vkx_upload(ctx, built.arrays.meshlets, built.stats.meshlet_count * sizeof(sp_meshlet),
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        m->meshlet_count = (uint32_t)built.stats.meshlet_count;
     }
-    free(out.meshlets);
-    free(out.vertices);
-    free(out.vertex_tuples);
-    free(out.triangles);
-    free(out.joints);
-    free(out.tuples);
-    free(scratch);
+    sp_gpu_meshlets_free(&built);
     free(joints_k);
     free(weights_k);
 }

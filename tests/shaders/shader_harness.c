@@ -532,39 +532,20 @@ static void test_meshlets(harness* h, const char* path)
         vkx_fail("%s: compress/decompress failed", path);
     uint32_t k = skin.influences;
 
-    sp_meshlet_options meshlet_options;
-    sp_meshlet_options_default(&meshlet_options);
-    sp_meshlet_sizes sizes;
-    sp_meshlets_bound((size_t)mesh.triangle_count * 3, n, k, &meshlet_options, &sizes);
-    sp_meshlet_buffers out = {
-        .meshlets = malloc(sizes.meshlets * sizeof(sp_meshlet)),
-        .vertices = malloc(sizes.vertices * sizeof(uint32_t)),
-        .vertex_tuples = malloc(sizes.vertices),
-        .triangles = malloc(sizes.triangles * 3),
-        .joints = malloc(sizes.joints * sizeof(uint16_t)),
-        .tuples = malloc(sizes.tuples * k),
-        .capacity = sizes,
-    };
-    void* meshlet_scratch = malloc(sizes.scratch_bytes);
-    sp_meshlet_stats stats;
-    sp_result result = sp_build_meshlets(mesh.indices, (size_t)mesh.triangle_count * 3, mesh.positions, n, 12, joints, weights,
-                                         k, &meshlet_options, &out, meshlet_scratch, sizes.scratch_bytes, &stats);
+    sp_gpu_meshlets built;
+    sp_result result = sp_gpu_meshlets_build(mesh.indices, (size_t)mesh.triangle_count * 3, mesh.positions, n, 12,
+                                             joints, weights, k, &built);
     if (result != SP_OK) vkx_fail("sp_build_meshlets: %s", sp_result_string(result));
+    const sp_meshlet_buffers out = built.arrays;
+    const sp_meshlet_stats stats = built.stats;
     printf("meshlets of %s: %zu meshlets, %zu vertex entries, %zu triangles, palettes up to %u joints\n", mesh.name,
            stats.meshlet_count, stats.vertex_count, stats.triangle_count, stats.max_joints);
 
     /* The five arrays in one word buffer, as skinpack_gpu_layout.h describes. */
-    size_t bytes[5] = {stats.vertex_count * 4, stats.vertex_count, stats.triangle_count * 3, stats.joint_count * 2,
-                       stats.tuple_count * k};
-    const void* arrays[5] = {out.vertices, out.vertex_tuples, out.triangles, out.joints, out.tuples};
     decode_push push = {SP_DECODE_MODE_MESHLETS, (uint32_t)stats.meshlet_count, 0, {0}};
-    size_t total_words = 0;
-    for (int a = 0; a < 5; ++a) {
-        push.meshlet_arrays[a] = (uint32_t)total_words;
-        total_words += (bytes[a] + 3) / 4;
-    }
-    uint32_t* data = calloc(total_words + 1, sizeof(uint32_t));
-    for (int a = 0; a < 5; ++a) memcpy(data + push.meshlet_arrays[a], arrays[a], bytes[a]);
+    for (int a = 0; a < 5; ++a) push.meshlet_arrays[a] = built.offsets[a];
+    const uint32_t* data = built.data;
+    size_t total_words = built.data_words;
 
     vkx_context* ctx = &h->ctx;
     SpGpuCodec gpu_codec = sp_gpu_codec_fill(&skin.codec, skin.tuple_bits, skin.words_per_vertex, skin.joint_bytes,
@@ -633,14 +614,7 @@ static void test_meshlets(harness* h, const char* path)
     vkResetDescriptorPool(ctx->device, ctx->descriptor_pool, 0);
     vkx_buffer* all[] = {&codec_buffer, &words_buffer, &meshlet_buffer, &data_buffer, &records_buffer, &corners_buffer};
     for (size_t i = 0; i < sizeof(all) / sizeof(all[0]); ++i) vkx_buffer_destroy(ctx, all[i]);
-    free(data);
-    free(out.meshlets);
-    free(out.vertices);
-    free(out.vertex_tuples);
-    free(out.triangles);
-    free(out.joints);
-    free(out.tuples);
-    free(meshlet_scratch);
+    sp_gpu_meshlets_free(&built);
     free(words);
     free(lut);
     free(joints);

@@ -151,3 +151,52 @@ _Static_assert(offsetof(sp_meshlet, cone_cutoff) == (SP_MESHLET_WORD_CONE_AXIS +
 /* The push-constant block is exactly the 128 bytes every device guarantees. */
 _Static_assert(sizeof(SpSkinParameters) == 128, "SpSkinParameters must stay 128 bytes");
 _Static_assert(sizeof(SpGpuCodec) == 8 * 16, "SpGpuCodec is 8 vec4s");
+
+sp_result sp_gpu_meshlets_build(const uint32_t* indices, size_t index_count, const float* positions,
+                                size_t vertex_count, size_t position_stride, const uint16_t* joints,
+                                const float* weights, size_t influences, sp_gpu_meshlets* out)
+{
+    memset(out, 0, sizeof(*out));
+    sp_meshlet_options options;
+    sp_meshlet_options_default(&options);
+    sp_meshlet_sizes sizes;
+    sp_meshlets_bound(index_count, vertex_count, influences, &options, &sizes);
+    sp_meshlet_buffers* a = &out->arrays;
+    a->meshlets = malloc(sizes.meshlets * sizeof(sp_meshlet));
+    a->vertices = malloc(sizes.vertices * sizeof(uint32_t));
+    a->vertex_tuples = malloc(sizes.vertices);
+    a->triangles = malloc(sizes.triangles * 3);
+    a->joints = malloc(sizes.joints * sizeof(uint16_t));
+    a->tuples = malloc(sizes.tuples * influences);
+    a->capacity = sizes;
+    void* scratch = malloc(sizes.scratch_bytes ? sizes.scratch_bytes : 1);
+    sp_result result = sp_build_meshlets(indices, index_count, positions, vertex_count, position_stride, joints,
+                                         weights, influences, &options, a, scratch, sizes.scratch_bytes, &out->stats);
+    free(scratch);
+    if (result != SP_OK) return result;
+
+    const sp_meshlet_stats* s = &out->stats;
+    size_t bytes[5] = {s->vertex_count * 4, s->vertex_count, s->triangle_count * 3, s->joint_count * 2,
+                       s->tuple_count * influences};
+    const void* arrays[5] = {a->vertices, a->vertex_tuples, a->triangles, a->joints, a->tuples};
+    for (int i = 0; i < 5; ++i) {
+        out->offsets[i] = (uint32_t)out->data_words;
+        out->data_words += (bytes[i] + 3) / 4;
+    }
+    out->data = calloc(out->data_words + 1, sizeof(uint32_t));
+    for (int i = 0; i < 5; ++i) memcpy(out->data + out->offsets[i], arrays[i], bytes[i]);
+    return SP_OK;
+}
+
+void sp_gpu_meshlets_free(sp_gpu_meshlets* meshlets)
+{
+    sp_meshlet_buffers* a = &meshlets->arrays;
+    free(a->meshlets);
+    free(a->vertices);
+    free(a->vertex_tuples);
+    free(a->triangles);
+    free(a->joints);
+    free(a->tuples);
+    free(meshlets->data);
+    memset(meshlets, 0, sizeof(*meshlets));
+}

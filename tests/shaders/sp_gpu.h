@@ -46,6 +46,22 @@ void sp_skin_mesh_free(sp_skin_mesh* mesh);
 void sp_reference_skin(const float* positions, size_t vertex_count, const uint16_t* joints, const float* weights,
                        size_t influences, const float* matrix_rows, float* out);
 
+/* Meshlets of a skin at the default limits (skin.mesh's 64 vertices / 124 triangles), with the
+ * library's arrays and the same arrays packed into one word buffer as skinpack_gpu_layout.h
+ * describes (offsets[a] = word offset of vertices, vertex_tuples, triangles, joints, tuples). */
+typedef struct sp_gpu_meshlets {
+    sp_meshlet_buffers arrays;
+    sp_meshlet_stats stats;
+    uint32_t* data;
+    size_t data_words;
+    uint32_t offsets[5];
+} sp_gpu_meshlets;
+
+sp_result sp_gpu_meshlets_build(const uint32_t* indices, size_t index_count, const float* positions,
+                                size_t vertex_count, size_t position_stride, const uint16_t* joints,
+                                const float* weights, size_t influences, sp_gpu_meshlets* out);
+void sp_gpu_meshlets_free(sp_gpu_meshlets* meshlets);
+
 /* Seconds since an arbitrary start (CLOCK_MONOTONIC). */
 double sp_seconds(void);
 
