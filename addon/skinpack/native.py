@@ -22,10 +22,12 @@ METHODS = ("fixed", "cube", "pot", "any", "oss")  # index == sp_method value
 
 # sp_result values the add-on reacts to (the rest are only shown as messages).
 SP_OK = 0
+SP_ERR_INVALID_ARGUMENT = 1
 SP_ERR_NONFINITE_WEIGHT = 3
 SP_ERR_NEGATIVE_WEIGHT = 4
 SP_ERR_NO_INFLUENCE = 5
 SP_ERR_JOINT_OUT_OF_RANGE = 6
+SP_ERR_LIMIT_EXCEEDED = 13
 # Results whose error_vertex names a vertex (the others are about parameters).
 PER_VERTEX_ERRORS = (SP_ERR_NONFINITE_WEIGHT, SP_ERR_NEGATIVE_WEIGHT, SP_ERR_NO_INFLUENCE, SP_ERR_JOINT_OUT_OF_RANGE)
 
@@ -102,12 +104,96 @@ class CompressedSkin(ctypes.Structure):
     ]
 
 
+# Meshlets (skinpack.h section "Meshlets", docs/meshlets.md).
+MESHLET_BUILDERS = ("naive", "common", "skin")  # index == sp_meshlet_builder value
+
+
+class MeshletOptions(ctypes.Structure):
+    _fields_ = [
+        ("builder", ctypes.c_uint32),
+        ("max_vertices", ctypes.c_uint32),
+        ("max_triangles", ctypes.c_uint32),
+        ("max_joints", ctypes.c_uint32),
+        ("min_group_triangles", ctypes.c_uint32),
+        ("joint_cost", ctypes.c_float),
+    ]
+
+
+class Meshlet(ctypes.Structure):
+    _fields_ = [
+        ("vertex_offset", ctypes.c_uint32),
+        ("triangle_offset", ctypes.c_uint32),
+        ("joint_offset", ctypes.c_uint32),
+        ("tuple_offset", ctypes.c_uint32),
+        ("vertex_count", ctypes.c_uint16),
+        ("triangle_count", ctypes.c_uint16),
+        ("joint_count", ctypes.c_uint16),
+        ("tuple_count", ctypes.c_uint16),
+        ("tuple_bits", ctypes.c_uint32),
+        ("center", ctypes.c_float * 3),
+        ("radius", ctypes.c_float),
+        ("cone_apex", ctypes.c_float * 3),
+        ("cone_axis", ctypes.c_float * 3),
+        ("cone_cutoff", ctypes.c_float),
+    ]
+
+
+class MeshletSizes(ctypes.Structure):
+    _fields_ = [
+        ("meshlets", ctypes.c_size_t),
+        ("vertices", ctypes.c_size_t),
+        ("triangles", ctypes.c_size_t),
+        ("joints", ctypes.c_size_t),
+        ("tuples", ctypes.c_size_t),
+        ("scratch_bytes", ctypes.c_size_t),
+    ]
+
+
+class MeshletBuffers(ctypes.Structure):
+    _fields_ = [
+        ("meshlets", ctypes.POINTER(Meshlet)),
+        ("vertices", ctypes.POINTER(ctypes.c_uint32)),
+        ("vertex_tuples", ctypes.POINTER(ctypes.c_uint8)),
+        ("triangles", ctypes.POINTER(ctypes.c_uint8)),
+        ("joints", ctypes.POINTER(ctypes.c_uint16)),
+        ("tuples", ctypes.POINTER(ctypes.c_uint8)),
+        ("triangle_meshlet", ctypes.POINTER(ctypes.c_uint32)),
+        ("capacity", MeshletSizes),
+    ]
+
+
+class MeshletStats(ctypes.Structure):
+    _fields_ = [
+        ("meshlet_count", ctypes.c_size_t),
+        ("vertex_count", ctypes.c_size_t),
+        ("triangle_count", ctypes.c_size_t),
+        ("joint_count", ctypes.c_size_t),
+        ("tuple_count", ctypes.c_size_t),
+        ("max_vertices", ctypes.c_uint32),
+        ("max_triangles", ctypes.c_uint32),
+        ("max_joints", ctypes.c_uint32),
+        ("mean_vertices", ctypes.c_double),
+        ("mean_triangles", ctypes.c_double),
+        ("mean_joints", ctypes.c_double),
+        ("global_tuples", ctypes.c_size_t),
+        ("global_tuple_bits", ctypes.c_uint32),
+        ("local_tuple_bits_mean", ctypes.c_double),
+        ("local_tuple_bits_max", ctypes.c_uint32),
+        ("error_triangle", ctypes.c_size_t),
+    ]
+
+
 MIRRORED_STRUCTS = {
     "sp_prepare_stats": PrepareStats,
     "sp_codec": Codec,
     "sp_error_stats": ErrorStats,
     "sp_compress_options": CompressOptions,
     "sp_compressed_skin": CompressedSkin,
+    "sp_meshlet_options": MeshletOptions,
+    "sp_meshlet": Meshlet,
+    "sp_meshlet_sizes": MeshletSizes,
+    "sp_meshlet_buffers": MeshletBuffers,
+    "sp_meshlet_stats": MeshletStats,
 }
 
 
@@ -151,6 +237,20 @@ def _declare(lib):
     lib.sp_codec_from_bits.argtypes = [ctypes.c_int, ctypes.c_uint32, ctypes.c_uint32, P(Codec)]
     lib.sp_method_name.restype = ctypes.c_char_p
     lib.sp_method_name.argtypes = [ctypes.c_int]
+    lib.sp_prepare_influences.restype = ctypes.c_int
+    lib.sp_prepare_influences.argtypes = [
+        P(ctypes.c_uint16), P(ctypes.c_float), ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t,
+        ctypes.c_float, P(ctypes.c_uint16), P(ctypes.c_float), P(ctypes.c_float), P(PrepareStats)]
+    lib.sp_meshlet_options_default.restype = None
+    lib.sp_meshlet_options_default.argtypes = [P(MeshletOptions)]
+    lib.sp_meshlets_bound.restype = None
+    lib.sp_meshlets_bound.argtypes = [ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t, P(MeshletOptions),
+                                      P(MeshletSizes)]
+    lib.sp_build_meshlets.restype = ctypes.c_int
+    lib.sp_build_meshlets.argtypes = [
+        P(ctypes.c_uint32), ctypes.c_size_t, P(ctypes.c_float), ctypes.c_size_t, ctypes.c_size_t,
+        P(ctypes.c_uint16), P(ctypes.c_float), ctypes.c_size_t, P(MeshletOptions), P(MeshletBuffers),
+        ctypes.c_void_p, ctypes.c_size_t, P(MeshletStats)]
 
 
 def library_path():
@@ -327,4 +427,110 @@ def stats_dict(compressed):
         "pruned_vertices": int(s.prepare.pruned_vertices),
         "max_pruning_error": float(s.prepare.max_pruning_error),
         "renormalized_vertices": int(s.prepare.renormalized_vertices),
+    }
+
+
+def prepare_influences(joints, weights, joint_count, max_influences, sum_tolerance=1e-3):
+    """sp_prepare_influences: (V, S) joints/weights -> (V, K) sorted by descending weight,
+    K = min(max_influences, S). Raises SkinpackError naming the first bad vertex."""
+    lib = _require()
+    joints = np.ascontiguousarray(joints, dtype=np.uint16)
+    weights = np.ascontiguousarray(weights, dtype=np.float32)
+    vertex_count, stride = weights.shape
+    K = min(max_influences, stride, SP_MAX_INFLUENCES)
+    out_joints = np.zeros((vertex_count, K), dtype=np.uint16)
+    out_weights = np.zeros((vertex_count, K), dtype=np.float32)
+    stats = PrepareStats()
+    code = lib.sp_prepare_influences(
+        _pointer(joints, ctypes.c_uint16), _pointer(weights, ctypes.c_float), vertex_count, stride, joint_count, K,
+        sum_tolerance, _pointer(out_joints, ctypes.c_uint16), _pointer(out_weights, ctypes.c_float), None,
+        ctypes.byref(stats))
+    if code != SP_OK:
+        raise SkinpackError(result_string(code), code, int(stats.error_vertex))
+    return out_joints, out_weights
+
+
+def meshlet_options(builder="skin", max_vertices=64, max_triangles=124, max_joints=32):
+    """sp_meshlet_options: the library's defaults with the builder and the three limits set."""
+    options = MeshletOptions()
+    _require().sp_meshlet_options_default(ctypes.byref(options))
+    options.builder = MESHLET_BUILDERS.index(builder)
+    options.max_vertices = max_vertices
+    options.max_triangles = max_triangles
+    options.max_joints = max_joints
+    return options
+
+
+class MeshletError(SkinpackError):
+    """sp_build_meshlets failed; triangle is stats.error_triangle where the result names one."""
+
+    def __init__(self, message, code, triangle):
+        super().__init__(message, code)
+        self.triangle = triangle
+
+
+class Meshlets:
+    """What sp_build_meshlets wrote, trimmed to the counts in stats (numpy views of the buffers)."""
+
+    def __init__(self, stats, meshlets, triangle_meshlet):
+        self.stats = stats  # MeshletStats
+        self.meshlets = meshlets  # structured array, one sp_meshlet per meshlet
+        self.triangle_meshlet = triangle_meshlet  # (T,) uint32: meshlet of each source triangle
+
+
+def build_meshlets(indices, positions, joints, weights, options):
+    """indices (T, 3) vertex indices, positions (V, 3) float32, joints/weights (V, K) as written by
+    prepare_influences. Every output buffer is a numpy array sized by sp_meshlets_bound."""
+    lib = _require()
+    indices = np.ascontiguousarray(indices, dtype=np.uint32).reshape(-1)
+    positions = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1, 3)
+    joints = np.ascontiguousarray(joints, dtype=np.uint16)
+    weights = np.ascontiguousarray(weights, dtype=np.float32)
+    vertex_count, K = weights.shape
+    sizes = MeshletSizes()
+    lib.sp_meshlets_bound(len(indices), vertex_count, K, ctypes.byref(options), ctypes.byref(sizes))
+    # One extra element each so that an empty array still has a valid address.
+    meshlets = np.zeros(sizes.meshlets + 1, dtype=np.dtype(Meshlet))
+    vertices = np.zeros(sizes.vertices + 1, dtype=np.uint32)
+    vertex_tuples = np.zeros(sizes.vertices + 1, dtype=np.uint8)
+    triangles = np.zeros(sizes.triangles * 3 + 1, dtype=np.uint8)
+    palette = np.zeros(sizes.joints + 1, dtype=np.uint16)
+    tuples = np.zeros(sizes.tuples * K + 1, dtype=np.uint8)
+    triangle_meshlet = np.zeros(len(indices) // 3 + 1, dtype=np.uint32)
+    scratch = np.zeros(sizes.scratch_bytes + 1, dtype=np.uint8)
+    buffers = MeshletBuffers()
+    buffers.meshlets = meshlets.ctypes.data_as(ctypes.POINTER(Meshlet))
+    buffers.vertices = _pointer(vertices, ctypes.c_uint32)
+    buffers.vertex_tuples = _pointer(vertex_tuples, ctypes.c_uint8)
+    buffers.triangles = _pointer(triangles, ctypes.c_uint8)
+    buffers.joints = _pointer(palette, ctypes.c_uint16)
+    buffers.tuples = _pointer(tuples, ctypes.c_uint8)
+    buffers.triangle_meshlet = _pointer(triangle_meshlet, ctypes.c_uint32)
+    buffers.capacity = sizes
+    stats = MeshletStats()
+    code = lib.sp_build_meshlets(
+        _pointer(indices, ctypes.c_uint32), len(indices), _pointer(positions, ctypes.c_float), vertex_count,
+        12, _pointer(joints, ctypes.c_uint16), _pointer(weights, ctypes.c_float), K, ctypes.byref(options),
+        ctypes.byref(buffers), scratch.ctypes.data_as(ctypes.c_void_p), sizes.scratch_bytes, ctypes.byref(stats))
+    if code != SP_OK:
+        triangle = int(stats.error_triangle) if code in (SP_ERR_LIMIT_EXCEEDED, SP_ERR_INVALID_ARGUMENT) else None
+        raise MeshletError(result_string(code), code, triangle)
+    return Meshlets(stats, meshlets[:stats.meshlet_count], triangle_meshlet[:len(indices) // 3])
+
+
+def meshlet_stats_dict(stats):
+    """The numbers the panel shows and the tests compare (plain Python values)."""
+    return {
+        "meshlet_count": int(stats.meshlet_count),
+        "triangle_count": int(stats.triangle_count),
+        "mean_vertices": float(stats.mean_vertices),
+        "mean_triangles": float(stats.mean_triangles),
+        "mean_joints": float(stats.mean_joints),
+        "max_vertices": int(stats.max_vertices),
+        "max_triangles": int(stats.max_triangles),
+        "max_joints": int(stats.max_joints),
+        "global_tuples": int(stats.global_tuples),
+        "global_tuple_bits": int(stats.global_tuple_bits),
+        "local_tuple_bits_mean": float(stats.local_tuple_bits_mean),
+        "local_tuple_bits_max": int(stats.local_tuple_bits_max),
     }

@@ -9,9 +9,9 @@ import os
 import time
 
 import bpy
-from bpy.props import EnumProperty, StringProperty
+from bpy.props import EnumProperty, IntProperty, StringProperty
 
-from . import gather, native, preview, storage
+from . import gather, meshlet_preview, native, preview, properties, storage
 
 
 def _active_mesh(context):
@@ -165,8 +165,55 @@ class SKINPACK_OT_preview_error(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class SKINPACK_OT_preview_meshlets(bpy.types.Operator):
+    """Split the active mesh into skin-aware meshlets with the library and colour its faces by meshlet"""
+    bl_idname = "skinpack.preview_meshlets"
+    bl_label = "Preview Meshlets"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    mode: EnumProperty(name="Mode", default='MESHLET', items=properties.MESHLET_MODE_ITEMS)
+    builder: EnumProperty(name="Builder", default='SKIN', items=properties.MESHLET_BUILDER_ITEMS)
+    max_vertices: IntProperty(name="Max Vertices", default=64, min=3, max=255)
+    max_triangles: IntProperty(name="Max Triangles", default=124, min=1, max=512)
+    palette_size: IntProperty(name="Palette Size", default=32, min=1, max=255,
+                              description="Distinct joints per meshlet")
+
+    @classmethod
+    def poll(cls, context):
+        return _poll_mesh(context)
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        if native.load() is None:
+            self.report({'ERROR'}, native.load_error())
+            return {'CANCELLED'}
+        builder = meshlet_preview.BUILDERS[self.builder]
+        progress = _Progress(context, 2)
+        try:
+            progress.step(0, "reading %s" % obj.name)
+            inputs = meshlet_preview.read_inputs(obj, obj.data.skinpack.max_influences)
+            progress.step(1, "building %s meshlets of %s" % (builder, obj.name))
+            options = native.meshlet_options(builder, self.max_vertices, self.max_triangles, self.palette_size)
+            meshlets = meshlet_preview.build(obj, inputs, options)
+        except (gather.GatherError, native.SkinpackError) as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        finally:
+            progress.end()
+        # Nothing is written to the mesh before this point, so a failure above leaves it untouched.
+        meshlet_preview.write(obj, self.mode, inputs, meshlets, self.palette_size)
+        preview.show_in_viewports(context, obj.data)
+        stats = meshlet_preview.store_stats(obj, meshlets.stats, self.builder, self.mode)
+        self.report({'INFO'}, "%s: %d %s meshlets, mean %.1f vertices, %.1f triangles, %.1f joints (max %d); "
+                    "tuple index %d bits global, %.2f local" % (
+                        obj.name, stats["meshlet_count"], builder, stats["mean_vertices"],
+                        stats["mean_triangles"], stats["mean_joints"], stats["max_joints"],
+                        stats["global_tuple_bits"], stats["local_tuple_bits_mean"]))
+        return {'FINISHED'}
+
+
 class SKINPACK_OT_clear_preview(bpy.types.Operator):
-    """Remove the error heat map and restore the viewport colouring"""
+    """Remove the error heat map or meshlet colours and restore the viewport colouring"""
     bl_idname = "skinpack.clear_preview"
     bl_label = "Clear Preview"
     bl_options = {'REGISTER', 'UNDO'}
@@ -176,7 +223,9 @@ class SKINPACK_OT_clear_preview(bpy.types.Operator):
         return _active_mesh(context) is not None
 
     def execute(self, context):
-        preview.clear(context, _active_mesh(context))
+        obj = _active_mesh(context)
+        preview.clear(context, obj)
+        obj.skinpack_meshlets.valid = False
         return {'FINISHED'}
 
 
@@ -315,8 +364,8 @@ class SKINPACK_OT_export_gltf(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (SKINPACK_OT_compress, SKINPACK_OT_preview_error, SKINPACK_OT_clear_preview,
-           SKINPACK_OT_toggle_decoded, SKINPACK_OT_export_gltf)
+classes = (SKINPACK_OT_compress, SKINPACK_OT_preview_error, SKINPACK_OT_preview_meshlets,
+           SKINPACK_OT_clear_preview, SKINPACK_OT_toggle_decoded, SKINPACK_OT_export_gltf)
 
 
 def register():

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import gather, native, preview, storage
+from . import gather, meshlet_preview, native, preview, properties, storage
 
 
 class SKINPACK_PT_skin(bpy.types.Panel):
@@ -63,6 +63,7 @@ class SKINPACK_PT_skin(bpy.types.Panel):
             col.operator("skinpack.export_gltf", icon='EXPORT')
         elif storage.showing_decoded(mesh):
             layout.operator("skinpack.toggle_decoded", text="Restore Original Weights", icon='LOOP_BACK')
+        _draw_meshlets(layout, context, obj)
 
 
 def _draw_stats(layout, mesh, result):
@@ -106,6 +107,59 @@ def _draw_preview(layout, context, mesh):
     ticks.label(text="%.2e" % (scale / 2))
     ticks.label(text="%.2e" % scale)
     box.label(text="Values %.2e \u2026 %.2e" % (minimum, maximum))
+
+
+def _draw_meshlets(layout, context, obj):
+    """The "Meshlets" box: builder and limits, the two preview modes, the library's stats."""
+    settings = obj.skinpack_meshlets
+    box = layout.box()
+    box.label(text="Meshlets", icon='MESH_ICOSPHERE')
+    box.prop(settings, "builder")
+    col = box.column(align=True)
+    col.prop(settings, "max_vertices")
+    col.prop(settings, "max_triangles")
+    col.prop(settings, "palette_size")
+    row = box.row(align=True)
+    for mode, text, icon in (('MESHLET', "Meshlets", 'MESH_ICOSPHERE'), ('JOINTS', "Joints", 'BONE_DATA')):
+        op = row.operator("skinpack.preview_meshlets", text=text, icon=icon)
+        op.mode = mode
+        op.builder = settings.builder
+        op.max_vertices = settings.max_vertices
+        op.max_triangles = settings.max_triangles
+        op.palette_size = settings.palette_size
+    row.operator("skinpack.clear_preview", text="", icon='X')
+    mode = meshlet_preview.shown_mode(obj.data)
+    if mode is None or not settings.valid:
+        return
+    builder_names = {key: name for key, name, _ in properties.MESHLET_BUILDER_ITEMS}
+    builder = builder_names.get(settings.shown_builder, settings.shown_builder)
+    grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
+    rows = (
+        ("Builder", builder),
+        ("Meshlets", "%d" % settings.meshlet_count),
+        ("Mean vertices", "%.1f" % settings.mean_vertices),
+        ("Mean triangles", "%.1f" % settings.mean_triangles),
+        ("Joints / meshlet", "%.1f mean, %d max" % (settings.mean_joints, settings.max_joints)),
+        ("Tuple index bits", "%d global → %.2f local (max %d)" % (
+            settings.global_tuple_bits, settings.local_tuple_bits_mean, settings.local_tuple_bits_max)),
+    )
+    for label, value in rows:
+        grid.label(text=label)
+        grid.label(text=value)
+    if mode == 'JOINTS':
+        # Same ramp as the error heat map, 0 to the palette size the preview was built with.
+        scale = obj.data[storage.PREVIEW_KEY].get("scale", 0.0)
+        box.label(text="Joints per meshlet")
+        swatches = box.row(align=True)
+        legend = context.window_manager.skinpack_legend
+        for index in range(len(preview.RAMP)):
+            swatches.prop(legend, "color_%d" % index, text="")
+        ticks = box.row()
+        ticks.label(text="0")
+        ticks.label(text="%g" % (scale / 2))
+        ticks.label(text="%g" % scale)
+    else:
+        box.label(text="One colour per meshlet (a face shows its first triangle's)")
 
 
 def _wrap(text, width):

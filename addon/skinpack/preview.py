@@ -1,5 +1,8 @@
 """Error heat map: a colour attribute coloured from per-vertex errors the library reports.
 
+The colour-attribute, viewport and clear helpers here are shared with the meshlet preview
+(meshlet_preview.py).
+
 WEIGHT mode shows the library's per-vertex quantisation error (L-inf over the vertex's
 weights, `per_vertex_error` of sp_compress_skin) as stored with the result. POSE mode shows
 how far each vertex moves in the current pose when it is skinned with the decoded instead of
@@ -12,6 +15,10 @@ import numpy as np
 from . import gather, storage
 
 ATTRIBUTE_NAME = "skinpack_error"
+MESHLET_ATTRIBUTE_NAME = "skinpack_meshlets"  # written by meshlet_preview.py
+# Every colour attribute a preview writes: one preview is shown at a time, Clear removes them
+# all and the glTF export hook keeps them out of COLOR_0.
+ATTRIBUTE_NAMES = (ATTRIBUTE_NAME, MESHLET_ATTRIBUTE_NAME)
 
 # Colour ramp of the heat map (linear RGBA), from no error to the legend's maximum.
 RAMP = (
@@ -39,29 +46,41 @@ def heat_colors(values, maximum):
     return ramp[lower] * (1.0 - fraction) + ramp[lower + 1] * fraction
 
 
+def write_color_attribute(mesh, name, domain, colors):
+    """Replaces every preview attribute with a float colour attribute `name` on `domain`
+    ('POINT' or 'CORNER': the domains Workbench colours by) and makes it the active and render
+    colour. colors: (element count, 4) float32."""
+    for existing in ATTRIBUTE_NAMES:
+        attribute = mesh.color_attributes.get(existing)
+        if attribute is not None:
+            mesh.color_attributes.remove(attribute)
+    attribute = mesh.color_attributes.new(name, 'FLOAT_COLOR', domain)
+    attribute.data.foreach_set("color", np.ascontiguousarray(colors, dtype=np.float32).ravel())
+    # Re-fetch by name: adding attributes can reallocate, leaving older references stale.
+    names = [a.name for a in mesh.color_attributes]
+    index = names.index(name)
+    mesh.color_attributes.active_color_index = index
+    mesh.color_attributes.render_color_index = index
+
+
+def remember_preview(mesh, info):
+    """Stores what the preview shows (info: mode and legend values) on the mesh, keeping the
+    scene colour type that show_in_viewports replaced for Clear."""
+    previous = mesh.get(storage.PREVIEW_KEY, {})
+    mesh[storage.PREVIEW_KEY] = dict(info, previous_color_type=previous.get("previous_color_type", ""))
+    mesh.update()
+
+
 def write_heat_map(obj, values, maximum, mode):
     """Writes the colour attribute, makes it the active and render colour, stores the legend."""
     mesh = obj.data
-    existing = mesh.color_attributes.get(ATTRIBUTE_NAME)
-    if existing is not None:
-        mesh.color_attributes.remove(existing)
-    attribute = mesh.color_attributes.new(ATTRIBUTE_NAME, 'FLOAT_COLOR', 'POINT')
-    colors = heat_colors(np.asarray(values, dtype=np.float32), maximum)
-    attribute.data.foreach_set("color", colors.ravel())
-    # Re-fetch by name: adding attributes can reallocate, leaving older references stale.
-    names = [a.name for a in mesh.color_attributes]
-    index = names.index(ATTRIBUTE_NAME)
-    mesh.color_attributes.active_color_index = index
-    mesh.color_attributes.render_color_index = index
-    previous = mesh.get(storage.PREVIEW_KEY, {})
-    mesh[storage.PREVIEW_KEY] = {
+    write_color_attribute(mesh, ATTRIBUTE_NAME, 'POINT', heat_colors(np.asarray(values, dtype=np.float32), maximum))
+    remember_preview(mesh, {
         "mode": mode,
         "minimum": float(np.min(values)) if len(values) else 0.0,
         "maximum": float(np.max(values)) if len(values) else 0.0,
         "scale": float(maximum),
-        "previous_color_type": previous.get("previous_color_type", ""),
-    }
-    mesh.update()
+    })
 
 
 def show_in_viewports(context, mesh):
@@ -86,9 +105,10 @@ def show_in_viewports(context, mesh):
 
 def clear(context, obj):
     mesh = obj.data
-    attribute = mesh.color_attributes.get(ATTRIBUTE_NAME)
-    if attribute is not None:
-        mesh.color_attributes.remove(attribute)
+    for name in ATTRIBUTE_NAMES:
+        attribute = mesh.color_attributes.get(name)
+        if attribute is not None:
+            mesh.color_attributes.remove(attribute)
     info = mesh.get(storage.PREVIEW_KEY)
     if info is not None:
         previous = info.get("previous_color_type")
@@ -101,7 +121,7 @@ def clear(context, obj):
 def legend(mesh):
     """(mode label, minimum, maximum, scale) of the current preview, or None."""
     info = mesh.get(storage.PREVIEW_KEY) if mesh is not None else None
-    if info is None or mesh.color_attributes.get(ATTRIBUTE_NAME) is None:
+    if info is None or mesh.color_attributes.get(ATTRIBUTE_NAME) is None or info["mode"] not in MODE_LABELS:
         return None
     return MODE_LABELS.get(info["mode"], info["mode"]), info["minimum"], info["maximum"], info["scale"]
 

@@ -1,7 +1,8 @@
-"""Settings stored with the mesh (compression) and the scene (glTF export)."""
+"""Settings stored with the mesh (compression), the object (meshlet preview) and the scene (glTF export)."""
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty,
+                       StringProperty)
 
 from . import preview
 
@@ -55,6 +56,43 @@ def _legend_property(index):
                                get=lambda self: preview.RAMP[index][:3], set=lambda self, value: None)
 
 
+MESHLET_BUILDER_ITEMS = (
+    ('SKIN', "Skin-Aware", "Spatial growth that also keeps each meshlet's joint palette small (ours)"),
+    ('COMMON', "Common Influences", "Triangles grouped by identical joint sets first (thesis listing A.2)"),
+    ('NAIVE', "Naive", "Triangles in index order, a new meshlet when one does not fit (thesis listing A.1)"),
+)
+
+MESHLET_MODE_ITEMS = (
+    ('MESHLET', "Meshlets", "A distinct colour per meshlet"),
+    ('JOINTS', "Joints", "Heat map of the distinct joints per meshlet, from 0 to the palette size"),
+)
+
+
+class SkinpackMeshletSettings(bpy.types.PropertyGroup):
+    """Meshlet preview settings of an object and the library's stats of its last preview."""
+    builder: EnumProperty(name="Builder", items=MESHLET_BUILDER_ITEMS, default='SKIN',
+                          description="Meshlet builder of the library")
+    max_vertices: IntProperty(name="Max Vertices", default=64, min=3, max=255,
+                              description="Vertices per meshlet (local indices are 8-bit)")
+    max_triangles: IntProperty(name="Max Triangles", default=124, min=1, max=512,
+                               description="Triangles per meshlet")
+    palette_size: IntProperty(name="Palette Size", default=32, min=1, max=255,
+                              description="Distinct joints per meshlet (the joint palette limit)")
+
+    # Stats of the preview shown (sp_meshlet_stats), read-only in the panel.
+    valid: BoolProperty(default=False, options={'HIDDEN'})
+    shown_builder: StringProperty(default="", options={'HIDDEN'})
+    shown_mode: StringProperty(default="", options={'HIDDEN'})
+    meshlet_count: IntProperty(name="Meshlets", default=0)
+    mean_vertices: FloatProperty(name="Mean Vertices", default=0.0)
+    mean_triangles: FloatProperty(name="Mean Triangles", default=0.0)
+    mean_joints: FloatProperty(name="Mean Joints", default=0.0)
+    max_joints: IntProperty(name="Max Joints", default=0)
+    global_tuple_bits: IntProperty(name="Global Tuple Bits", default=0)
+    local_tuple_bits_mean: FloatProperty(name="Local Tuple Bits", default=0.0)
+    local_tuple_bits_max: IntProperty(name="Max Local Tuple Bits", default=0)
+
+
 class SkinpackLegend(bpy.types.PropertyGroup):
     color_0: _legend_property(0)
     color_1: _legend_property(1)
@@ -63,7 +101,7 @@ class SkinpackLegend(bpy.types.PropertyGroup):
     color_4: _legend_property(4)
 
 
-classes = (SkinpackMeshSettings, SkinpackExportSettings, SkinpackLegend)
+classes = (SkinpackMeshSettings, SkinpackExportSettings, SkinpackMeshletSettings, SkinpackLegend)
 
 
 def register():
@@ -71,11 +109,13 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Mesh.skinpack = PointerProperty(type=SkinpackMeshSettings)
     bpy.types.Scene.skinpack_export = PointerProperty(type=SkinpackExportSettings)
+    bpy.types.Object.skinpack_meshlets = PointerProperty(type=SkinpackMeshletSettings)
     bpy.types.WindowManager.skinpack_legend = PointerProperty(type=SkinpackLegend)
 
 
 def unregister():
     del bpy.types.WindowManager.skinpack_legend
+    del bpy.types.Object.skinpack_meshlets
     del bpy.types.Scene.skinpack_export
     del bpy.types.Mesh.skinpack
     for cls in reversed(classes):

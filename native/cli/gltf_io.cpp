@@ -587,22 +587,27 @@ extern "C" int gltf_read_accessor_u32(const gltf_doc* doc, int accessor, int com
         }
     return 0;
 }
+// A dense, non-sparse accessor over a bufferView (-1: no data).
+static tinygltf::Accessor plain_accessor(int view, int component_type, int normalized, size_t count, int components) {
+    tinygltf::Accessor accessor;
+    accessor.bufferView = view;
+    accessor.byteOffset = 0;
+    accessor.componentType = component_type;
+    accessor.normalized = normalized != 0;
+    accessor.count = count;
+    accessor.type = type_for_components(components);
+    accessor.sparse.isSparse = false;
+    return accessor;
+}
+
 
 // ---- editing ----
 
 extern "C" int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, int component_type, int components,
                                  int normalized, int flags) {
     tinygltf::Model& model = doc->model;
-    if (!data) {
-        tinygltf::Accessor placeholder;
-        placeholder.bufferView = -1;
-        placeholder.byteOffset = 0;
-        placeholder.componentType = component_type;
-        placeholder.normalized = normalized != 0;
-        placeholder.count = count;
-        placeholder.type = type_for_components(components);
-        placeholder.sparse.isSparse = false;
-        model.accessors.push_back(placeholder);
+    if (!data) { // a data-less placeholder (compact mode's JOINTS_0/WEIGHTS_0)
+        model.accessors.push_back(plain_accessor(-1, component_type, normalized, count, components));
         return int(model.accessors.size() - 1);
     }
     size_t csize = component_size(component_type);
@@ -624,14 +629,8 @@ extern "C" int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, 
     out.insert(out.end(), static_cast<const unsigned char*>(data), static_cast<const unsigned char*>(data) + bytes);
     model.bufferViews.push_back(view);
 
-    tinygltf::Accessor accessor;
-    accessor.bufferView = int(model.bufferViews.size() - 1);
-    accessor.byteOffset = 0;
-    accessor.componentType = component_type;
-    accessor.normalized = normalized != 0;
-    accessor.count = count;
-    accessor.type = type_for_components(components);
-    accessor.sparse.isSparse = false;
+    tinygltf::Accessor accessor =
+        plain_accessor(int(model.bufferViews.size() - 1), component_type, normalized, count, components);
     model.accessors.push_back(accessor);
     if (!(flags & GLTF_ACCESSOR_BOUNDS)) return int(model.accessors.size() - 1);
     element_view ev = {static_cast<const unsigned char*>(data), size_t(components) * csize, count, size_t(components),

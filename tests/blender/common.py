@@ -181,3 +181,54 @@ def max_map_difference(a, b):
         for joint in set(left) | set(right):
             worst = max(worst, abs(left.get(joint, 0.0) - right.get(joint, 0.0)))
     return worst
+
+
+# --- rendered pictures ------------------------------------------------------------------------
+
+def picture_summary(pixels):
+    """(covered fraction, quantised colour count, covered RGB rows) of an (H, W, C) render: the
+    background is the median of the first and last rows' pixels, 'covered' differs from it."""
+    flat = pixels[:, :, :3].reshape(-1, 3)
+    background = numpy.median(numpy.concatenate([flat[:50], flat[-50:]]), axis=0)
+    covered = numpy.abs(flat - background).max(axis=1) > 0.05
+    quantised = numpy.unique((flat[covered] * 16).astype(numpy.int32), axis=0)
+    return float(covered.mean()), len(quantised), flat[covered]
+
+
+# --- panels -----------------------------------------------------------------------------------
+
+class RecordingLayout:
+    """Stands in for UILayout: records every label and operator so a panel's draw() can be
+    checked headless (background mode has no UI to draw into)."""
+
+    def __init__(self, texts):
+        self.texts = texts
+        self.use_property_split = self.use_property_decorate = False
+        self.enabled = self.active = True
+        self.scale_y = 1.0
+
+    def label(self, text="", icon='NONE'):
+        self.texts.append(text)
+
+    def prop(self, *args, **kwargs):
+        pass
+
+    def operator(self, idname, **kwargs):
+        self.texts.append("operator:" + idname)
+        return type("Properties", (), {})()
+
+    def row(self, **kwargs):
+        return self
+
+    column = box = grid_flow = row
+
+
+def draw_skinpack_panel(obj):
+    """The texts the Skinpack panel draws for obj."""
+    from skinpack import panel
+    texts = []
+    fake = type("FakePanel", (), {"layout": RecordingLayout(texts)})()
+    context = type("Context", (), {"object": obj, "window_manager": bpy.context.window_manager})()
+    check(panel.SKINPACK_PT_skin.poll(context), "panel does not poll for %s" % obj.name)
+    panel.SKINPACK_PT_skin.draw(fake, context)
+    return texts

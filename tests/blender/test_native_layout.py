@@ -65,6 +65,30 @@ def main():
         significant = decoded_weights > 0
         common.check((decoded_joints[significant] == reference_joints[significant]).all(), method + ": joints")
 
+    # Meshlets: the library's defaults, and a limit error that names its triangle. Two triangles
+    # whose vertices use three joints each (one per vertex).
+    options = native.meshlet_options()
+    common.check((native.MESHLET_BUILDERS[options.builder], options.max_vertices, options.max_triangles,
+                  options.max_joints) == ("skin", 64, 124, 32), "unexpected defaults from sp_meshlet_options_default")
+    positions = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0), (2, 1, 0)], dtype=np.float32)
+    indices = np.array([(0, 1, 2), (2, 1, 3), (3, 1, 4)], dtype=np.uint32)
+    mesh_joints, mesh_weights = native.prepare_influences(np.array([[0], [1], [2], [3], [4]]),
+                                                          np.ones((5, 1), dtype=np.float32), 5, 4)
+    for builder in native.MESHLET_BUILDERS:
+        built = native.build_meshlets(indices, positions, mesh_joints, mesh_weights,
+                                      native.meshlet_options(builder, max_joints=4))
+        stats = native.meshlet_stats_dict(built.stats)
+        common.check(stats["triangle_count"] == 3 and stats["max_joints"] <= 4
+                     and int(built.meshlets["triangle_count"].sum()) == 3
+                     and (np.bincount(built.triangle_meshlet, minlength=len(built.meshlets))
+                          == built.meshlets["triangle_count"]).all(), builder + ": meshlets of three triangles")
+    try:
+        native.build_meshlets(indices, positions, mesh_joints, mesh_weights, native.meshlet_options(max_joints=2))
+    except native.MeshletError as error:
+        common.check(error.code == native.SP_ERR_LIMIT_EXCEEDED and error.triangle == 0, "error %r" % error)
+    else:
+        raise AssertionError("a 3-joint triangle fitted a palette of 2")
+
     # Errors come back as SkinpackError naming the vertex, not as a crash.
     bad = weights.copy()
     bad[123, 0] = np.nan

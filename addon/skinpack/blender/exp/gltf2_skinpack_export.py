@@ -102,11 +102,11 @@ def extension_json(compressed, joint_count):
 
 
 def _drop_heat_map(gltf_mesh, blender_mesh):
-    """The exporter writes the render colour attribute as COLOR_0; when that is Skinpack's error
-    preview it is a visualisation, not content, and stays out of the file."""
+    """The exporter writes the render colour attribute as COLOR_0; when that is one of Skinpack's
+    previews (error heat map, meshlets) it is a visualisation, not content, and stays out of the file."""
     colors = blender_mesh.color_attributes
     index = colors.render_color_index
-    if 0 <= index < len(colors) and colors[index].name == preview.ATTRIBUTE_NAME:
+    if 0 <= index < len(colors) and colors[index].name in preview.ATTRIBUTE_NAMES:
         for primitive in gltf_mesh.primitives:
             primitive.attributes.pop("COLOR_0", None)
 
