@@ -87,6 +87,17 @@ def _draw_stats(layout, mesh, result):
         grid.label(text=value)
 
 
+def _draw_ramp(box, context, scale, number_format):
+    """The heat-map colour ramp as swatches with 0, scale/2 and scale under it."""
+    swatches = box.row(align=True)
+    legend = context.window_manager.skinpack_legend
+    for index in range(len(preview.RAMP)):
+        swatches.prop(legend, "color_%d" % index, text="")
+    ticks = box.row()
+    for value in (0, scale / 2, scale):
+        ticks.label(text=number_format % value if value else "0")
+
+
 def _draw_preview(layout, context, mesh):
     row = layout.row(align=True)
     row.operator("skinpack.preview_error", text="Weight Error", icon='GROUP_VCOL').mode = 'WEIGHT'
@@ -98,14 +109,7 @@ def _draw_preview(layout, context, mesh):
     label, minimum, maximum, scale = shown
     box = layout.box()
     box.label(text=label)
-    swatches = box.row(align=True)
-    legend = context.window_manager.skinpack_legend
-    for index in range(len(preview.RAMP)):
-        swatches.prop(legend, "color_%d" % index, text="")
-    ticks = box.row()
-    ticks.label(text="0")
-    ticks.label(text="%.2e" % (scale / 2))
-    ticks.label(text="%.2e" % scale)
+    _draw_ramp(box, context, scale, "%.2e")
     box.label(text="Values %.2e \u2026 %.2e" % (minimum, maximum))
 
 
@@ -150,14 +154,7 @@ def _draw_meshlets(layout, context, obj):
         # Same ramp as the error heat map, 0 to the palette size the preview was built with.
         scale = obj.data[storage.PREVIEW_KEY].get("scale", 0.0)
         box.label(text="Joints per meshlet")
-        swatches = box.row(align=True)
-        legend = context.window_manager.skinpack_legend
-        for index in range(len(preview.RAMP)):
-            swatches.prop(legend, "color_%d" % index, text="")
-        ticks = box.row()
-        ticks.label(text="0")
-        ticks.label(text="%g" % (scale / 2))
-        ticks.label(text="%g" % scale)
+        _draw_ramp(box, context, scale, "%g")
     else:
         box.label(text="One colour per meshlet (a face shows its first triangle's)")
 

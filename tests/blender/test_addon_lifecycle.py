@@ -12,45 +12,10 @@ import common  # noqa: E402
 import addon_utils  # noqa: E402
 import bpy  # noqa: E402
 
-OPERATORS = ("compress", "preview_error", "clear_preview", "toggle_decoded", "export_gltf")
+OPERATORS = ("compress", "preview_error", "clear_preview", "toggle_decoded", "export_gltf", "preview_meshlets")
 TYPES = ("SKINPACK_OT_compress", "SKINPACK_OT_preview_error", "SKINPACK_OT_clear_preview",
-         "SKINPACK_OT_toggle_decoded", "SKINPACK_OT_export_gltf", "SKINPACK_PT_skin")
+         "SKINPACK_OT_toggle_decoded", "SKINPACK_OT_export_gltf", "SKINPACK_OT_preview_meshlets", "SKINPACK_PT_skin")
 CLASSES = []  # every class the add-on registers, collected while it is enabled
-
-
-class RecordingLayout:
-    """Stands in for UILayout: records every label so a panel's draw() can be checked headless."""
-
-    def __init__(self, texts):
-        self.texts = texts
-        self.use_property_split = self.use_property_decorate = False
-        self.enabled = self.active = True
-        self.scale_y = 1.0
-
-    def label(self, text="", icon='NONE'):
-        self.texts.append(text)
-
-    def prop(self, *args, **kwargs):
-        pass
-
-    def operator(self, idname, **kwargs):
-        self.texts.append("operator:" + idname)
-        return type("Properties", (), {})()
-
-    def row(self, **kwargs):
-        return self
-
-    column = box = grid_flow = row
-
-
-def draw_panel(obj):
-    from skinpack import panel
-    texts = []
-    fake = type("FakePanel", (), {"layout": RecordingLayout(texts)})()
-    context = type("Context", (), {"object": obj, "window_manager": bpy.context.window_manager})()
-    common.check(panel.SKINPACK_PT_skin.poll(context), "panel does not poll for %s" % obj.name)
-    panel.SKINPACK_PT_skin.draw(fake, context)
-    return texts
 
 
 def registered_names():
@@ -59,6 +24,7 @@ def registered_names():
     present += ["Mesh.skinpack"] if hasattr(bpy.types.Mesh, "skinpack") else []
     present += ["Scene.skinpack_export"] if hasattr(bpy.types.Scene, "skinpack_export") else []
     present += ["WindowManager.skinpack_legend"] if hasattr(bpy.types.WindowManager, "skinpack_legend") else []
+    present += ["Object.skinpack_meshlets"] if hasattr(bpy.types.Object, "skinpack_meshlets") else []
     menu = bpy.types.TOPBAR_MT_file_export
     draw_funcs = getattr(menu.draw, "_draw_funcs", [])
     present += ["export menu"] if any(getattr(f, "__module__", "").startswith("skinpack") for f in draw_funcs) else []
@@ -83,11 +49,11 @@ def main():
         common.check("skinpack" not in bpy.context.preferences.addons, "still listed as enabled")
         addon_utils.enable("skinpack", default_set=True, handle_error=common._raise)
         common.check(bpy.ops.skinpack.compress() == {'FINISHED'}, "compress after re-enable")
-    texts = draw_panel(obj)
+    texts = common.draw_skinpack_panel(obj)
     common.check(any(t.startswith("operator:skinpack.compress") for t in texts), "panel without Compress: %s" % texts)
     common.check(any("Ratio" == t for t in texts), "panel without stats: %s" % texts)
     bpy.ops.skinpack.preview_error(mode='WEIGHT')
-    texts = draw_panel(obj)
+    texts = common.draw_skinpack_panel(obj)
     common.check(any(t.startswith("Weight error") for t in texts) and any(t.startswith("Values ") for t in texts),
                  "panel without heat-map legend: %s" % texts)
 
@@ -99,7 +65,7 @@ def main():
     common.check(hasattr(bpy.types, "SKINPACK_PT_gltf_export"), "exporter panel not registered")
     module.register_panel()  # the exporter calls it on every invoke
     texts = []
-    module.blender.exp.gltf2_skinpack_export.draw_settings(RecordingLayout(texts), bpy.context)
+    module.blender.exp.gltf2_skinpack_export.draw_settings(common.RecordingLayout(texts), bpy.context)
     common.check(any("Skinpack panel" in t for t in texts), "exporter section draws nothing useful: %s" % texts)
     unregister()
     common.check(not hasattr(bpy.types, "SKINPACK_PT_gltf_export"), "exporter panel left registered")
@@ -128,7 +94,7 @@ def broken_library_main():
     args = common.arguments()
     common.install_addon(args.zip)  # registers although the library is missing
     obj = common.open_asset(args, "skinned_cylinder.blend", "Cylinder")
-    texts = draw_panel(obj)
+    texts = common.draw_skinpack_panel(obj)
     common.check(any("could not be loaded" in t for t in texts), "no load message in panel: %s" % texts)
     common.check(any("libskinpack.so" in t for t in texts), "message does not name the library: %s" % texts)
     before = common.weight_snapshot(obj.data)
