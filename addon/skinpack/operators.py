@@ -368,11 +368,4 @@ classes = (SKINPACK_OT_compress, SKINPACK_OT_preview_error, SKINPACK_OT_preview_
            SKINPACK_OT_clear_preview, SKINPACK_OT_toggle_decoded, SKINPACK_OT_export_gltf)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)
