@@ -353,8 +353,9 @@ sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, s
 {
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
+    size_t first = sp_oss_encode_batch(codec, weights, vertex_count, codes, significant); /* vector prefix */
 #define SP_ENCODE_LOOP(K)                                                                            \
-    for (size_t v = 0; v < vertex_count; ++v)                                                       \
+    for (size_t v = first; v < vertex_count; ++v)                                                   \
         codes[v] = encode_one(codec, weights + v * (K), (K), significant ? significant + v : NULL);
     switch (k) {
     case 2: SP_ENCODE_LOOP(2) break;
@@ -371,7 +372,8 @@ sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, 
 {
     if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
-    for (size_t v = 0; v < vertex_count; ++v) {
+    size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights); /* vector prefix */
+    for (size_t v = first; v < vertex_count; ++v) {
         if (!code_is_valid(codec, codes[v])) {
             if (error_vertex) *error_vertex = v;
             return SP_ERR_CODE_OUT_OF_RANGE;

@@ -50,13 +50,18 @@ static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint6
         total += q[i];
     }
     order_by_remainder(remainder, k, order);
-    for (uint32_t t = 0; total < s; ++t, ++total) q[order[t % k]]++;
-    for (uint32_t t = 0; total > s; ++t) {
-        uint32_t slot = order[k - 1 - t % k];
-        if (q[slot] > 0) {
-            q[slot]--;
-            --total;
-        }
+    /* The deficit is 0..k-1 for proper input; degenerate input (a sum of zero or rounding of
+     * huge grids) is settled in bulk, never one grid step at a time. */
+    if (total < s) {
+        uint64_t deficit = (uint64_t)(s - total);
+        for (uint32_t i = 0; i < k; ++i) q[i] += deficit / k;
+        for (uint32_t t = 0; t < deficit % k; ++t) q[order[t]]++;
+    }
+    for (uint32_t t = 0; total > s && t < k; ++t) { /* smallest remainders give back first */
+        uint32_t slot = order[k - 1 - t];
+        uint64_t take = (uint64_t)(total - s) < q[slot] ? (uint64_t)(total - s) : q[slot];
+        q[slot] -= take;
+        total -= take;
     }
     /* Keep descending order even where the rounding loops above had to wrap around. */
     for (uint32_t i = 1; i < k; ++i)

@@ -29,7 +29,8 @@ static inline __attribute__((always_inline)) void sp_grid_quantize(const float* 
         int64_t deficit = (int64_t)s;
         for (uint32_t i = 0; i < k; ++i) {
             double x = weights[i] * scale;
-            x = x > 0 ? x : 0; /* also maps NaN to 0 */
+            x = x > 0 ? x : 0;                 /* also maps NaN to 0 */
+            x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
             int64_t f = (int64_t)x;
             q[i] = (uint64_t)f;
             remainder[i] = x - (double)f;
@@ -59,6 +60,14 @@ void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q);
 /* OSS: simplex index of grid coordinates and back (q[0] is implied by the others). */
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q);
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q);
+
+/* OSS batch fast paths (codec_oss_batch.c): encode or decode a prefix of the vertices with
+ * vector code where the CPU and the codec allow it, bit-identical to the scalar path; return
+ * how many leading vertices were done (0 when not applicable). Decode stops before a block
+ * holding a code above max_code, so the scalar loop reports it. */
+size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                           uint8_t* significant);
+size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
 
 /* Any AABB works on floats directly (its axes do not share a grid). */
 uint64_t sp_any_encode(const sp_codec* codec, const float* weights);

@@ -122,6 +122,22 @@ static void fixed_point_is_exact(void)
         }
 }
 
+/* Degenerate weights (the public encoder does not validate): a valid code, quickly. */
+static void degenerate_input_is_defined(void)
+{
+    const float cases[][4] = {{0, 0, 0, 0}, {NAN, 0.5f, 0.25f, 0}, {INFINITY, 1, 0, 0}, {1e-45f, 0, 0, 0},
+                              {-1, 2, 0, 0}, {3e38f, 3e38f, 3e38f, 3e38f}};
+    for (size_t m = 0; m < 5; ++m)
+        for (uint32_t bits = 20; bits <= 64; bits += 44) {
+            sp_codec c;
+            CHECK(sp_codec_from_bits(methods[m], 4, bits, &c) == SP_OK);
+            for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); ++i) {
+                uint64_t code = sp_encode_weights(&c, cases[i]);
+                CHECK_MSG(code <= c.max_code, "%s case %zu", sp_method_name(methods[m]), i);
+            }
+        }
+}
+
 static void configuration_errors(void)
 {
     sp_codec c;
@@ -166,5 +182,6 @@ int main(void)
     bound_holds_on_random_input();
     fixed_point_is_exact();
     configuration_errors();
+    degenerate_input_is_defined();
     return check_report("test_codecs");
 }

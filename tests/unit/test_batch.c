@@ -1,0 +1,249 @@
+/*
+ * Batch encode/decode against the single-vertex path, bit for bit. The batch functions take a
+ * vector path for OSS (codec_oss_batch.c) on blocks of vertices and leave the tail and any odd
+ * lane to the scalar code; a batch of one vertex is always scalar, so it is the reference.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "skinpack.h"
+
+/* Reference: each vertex on its own (a one-vertex batch never reaches the vector path). */
+static void encode_reference(const sp_codec* c, const float* w, size_t count, uint64_t* codes, uint8_t* sig)
+{
+    for (size_t v = 0; v < count; ++v)
+        sp_encode_weights_batch(c, w + v * c->influences, 1, codes + v, sig + v);
+}
+
+/* Batch-encodes count vertices and compares codes and significant counts with the reference;
+ * also the run without significant. Returns the failures seen. */
+static int compare_encode(const sp_codec* c, const float* w, size_t count, const char* what)
+{
+    uint64_t* codes = malloc((count + 1) * sizeof(uint64_t));
+    uint64_t* bare = malloc((count + 1) * sizeof(uint64_t));
+    uint64_t* ref = malloc((count + 1) * sizeof(uint64_t));
+    uint8_t* sig = malloc(count + 1);
+    uint8_t* ref_sig = malloc(count + 1);
+    int before = check_failures;
+    encode_reference(c, w, count, ref, ref_sig);
+    CHECK(sp_encode_weights_batch(c, w, count, codes, sig) == SP_OK);
+    CHECK(sp_encode_weights_batch(c, w, count, bare, NULL) == SP_OK);
+    for (size_t v = 0; v < count; ++v) {
+        CHECK_MSG(codes[v] == ref[v] && bare[v] == ref[v], "%s K=%u N=%llu vertex %zu: %llu vs %llu (w %.9g %.9g %.9g %.9g)",
+                  what, c->influences, (unsigned long long)c->n, v, (unsigned long long)codes[v],
+                  (unsigned long long)ref[v], w[v * c->influences], w[v * c->influences + 1],
+                  c->influences > 2 ? w[v * c->influences + 2] : 0.0f, c->influences > 3 ? w[v * c->influences + 3] : 0.0f);
+        CHECK_MSG(sig[v] == ref_sig[v], "%s significant K=%u vertex %zu", what, c->influences, v);
+        if (check_failures - before > 5) break;
+    }
+    free(codes), free(bare), free(ref), free(sig), free(ref_sig);
+    return check_failures - before;
+}
+
+/* Batch-decodes and compares the floats bit for bit with sp_decode_weights. */
+static int compare_decode(const sp_codec* c, const uint64_t* codes, size_t count, const char* what)
+{
+    uint32_t k = c->influences;
+    float* w = malloc((count * k + 1) * sizeof(float));
+    float* ref = malloc((count * k + 1) * sizeof(float));
+    int before = check_failures;
+    size_t bad = (size_t)-1;
+    CHECK(sp_decode_weights_batch(c, codes, count, w, &bad) == SP_OK);
+    CHECK(bad == (size_t)-1);
+    for (size_t v = 0; v < count; ++v) {
+        sp_decode_weights(c, codes[v], ref + v * k);
+        CHECK_MSG(memcmp(w + v * k, ref + v * k, k * sizeof(float)) == 0, "%s K=%u N=%llu code %llu", what, k,
+                  (unsigned long long)c->n, (unsigned long long)codes[v]);
+        if (check_failures - before > 5) break;
+    }
+    free(w), free(ref);
+    return check_failures - before;
+}
+
+static sp_codec oss(uint32_t k, uint64_t n)
+{
+    sp_codec c;
+    CHECK(sp_codec_from_params(SP_METHOD_OSS, k, n, NULL, &c) == SP_OK);
+    return c;
+}
+
+/* Every code of small N: decode them all in one batch, then encode the decoded weights and
+ * the same weights nudged by one float step both ways (remainders near 0 and 1). */
+static void exhaustive_small(void)
+{
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (uint64_t n = 2; n <= (k == 4 ? 60u : 120u); ++n) {
+            sp_codec c = oss(k, n);
+            size_t count = (size_t)c.max_code + 1;
+            uint64_t* codes = malloc(count * sizeof(uint64_t));
+            float* w = malloc(count * k * sizeof(float));
+            for (size_t v = 0; v < count; ++v) codes[v] = v;
+            if (compare_decode(&c, codes, count, "exhaustive decode")) return;
+            CHECK(sp_decode_weights_batch(&c, codes, count, w, NULL) == SP_OK);
+            if (compare_encode(&c, w, count, "exhaustive encode")) return;
+            for (int dir = -1; dir <= 1; dir += 2) {
+                for (size_t i = 0; i < count * k; ++i) w[i] = nextafterf(w[i], dir < 0 ? 0.0f : 1.0f);
+                if (compare_encode(&c, w, count, "nudged encode")) return;
+            }
+            free(codes), free(w);
+        }
+}
+
+/* A sorted random tuple summing to ~1, drawn from shapes that stress the rounding: plain,
+ * ties, zeros, one-hot, grid points (ties of remainders), and values just off grid points. */
+static void random_tuple(uint32_t k, uint64_t s, float* w)
+{
+    double raw[4] = {0, 0, 0, 0}, sum = 0;
+    uint64_t shape = rng_next() % 8;
+    for (uint32_t i = 0; i < k; ++i) raw[i] = rng_unit();
+    if (shape == 1) raw[1] = raw[0];                                   /* a tie */
+    if (shape == 2) for (uint32_t i = 1 + (uint32_t)(rng_next() % (k - 1)); i < k; ++i) raw[i] = 0; /* zeros */
+    if (shape == 3) for (uint32_t i = 1; i < k; ++i) raw[i] = 0;        /* one-hot */
+    if (shape == 4) for (uint32_t i = 0; i < k; ++i) raw[i] = 1;        /* all equal */
+    if (shape == 5 || shape == 6) /* on the grid (shape 6: half a step off) */
+        for (uint32_t i = 0; i < k; ++i) raw[i] = floor(raw[i] * (double)s / k) + (shape == 6 ? 0.5 : 0);
+    for (uint32_t i = 0; i < k; ++i) sum += raw[i];
+    if (!(sum > 0)) raw[0] = sum = 1;
+    for (uint32_t i = 1; i < k; ++i) /* descending */
+        for (uint32_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
+            double t = raw[j];
+            raw[j] = raw[j - 1];
+            raw[j - 1] = t;
+        }
+    for (uint32_t i = 0; i < k; ++i) w[i] = (float)(raw[i] / sum);
+    if (shape == 7) w[rng_next() % k] = nextafterf(w[0], 2.0f); /* off by one float step, maybe unsorted */
+}
+
+/* Millions of random tuples on the bench budgets and at the edges of the vector path. */
+static void random_tuples(void)
+{
+    static const uint32_t budgets[] = {8, 16, 22, 26, 30, 38, 44, 52, 64};
+    size_t count = 300000;
+    float* w = malloc(count * 4 * sizeof(float));
+    uint64_t* codes = malloc(count * sizeof(uint64_t));
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+            sp_codec c;
+            if (sp_codec_from_bits(SP_METHOD_OSS, k, budgets[b], &c) != SP_OK) continue;
+            for (size_t v = 0; v < count; ++v) random_tuple(k, c.scale, w + v * k);
+            if (compare_encode(&c, w, count, "random encode")) return;
+            for (size_t v = 0; v < count; ++v) codes[v] = rng_next() % (c.max_code + 1 ? c.max_code + 1 : UINT64_MAX);
+            if (compare_decode(&c, codes, count, "random decode")) return;
+        }
+    free(w), free(codes);
+}
+
+/* N at and just past the largest the vector path accepts (exact there, scalar beyond), and
+ * codes at every layer and row start/end there, where the root estimates are off by one. */
+static void range_edges(void)
+{
+    static const uint64_t limits[5] = {0, 0, (uint64_t)1 << 48, (uint64_t)1 << 23, (uint64_t)1 << 15};
+    size_t count = 200000;
+    float* w = malloc(count * 4 * sizeof(float));
+    uint64_t* codes = malloc(count * sizeof(uint64_t));
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (uint64_t n = limits[k] - 1; n <= limits[k] + 1; ++n) {
+            sp_codec c = oss(k, n);
+            for (size_t v = 0; v < count; ++v) random_tuple(k, c.scale, w + v * k);
+            if (compare_encode(&c, w, count, "edge encode")) return;
+            for (size_t v = 0; v < count; ++v) {
+                uint64_t layer = k == 4 ? rng_next() % ((n + 1) / 2) : 0, bottom = n - 2 * layer;
+                uint64_t base = k == 4 ? sp_oss_layer_base(n, layer) : 0;
+                uint64_t row = rng_next() % ((2 * bottom + 1) / 3), code = rng_next() % (c.max_code + 1);
+                if (k > 2 && v % 3 == 0) code = base + sp_oss_row_base(bottom, row);  /* row start */
+                if (k > 2 && v % 3 == 1) code = base + sp_oss_row_base(bottom, row + 1) - 1; /* row end */
+                if (k == 4 && v % 7 == 0) code = base - (layer > 0);                  /* layer end */
+                codes[v] = code;
+            }
+            if (compare_decode(&c, codes, count, "edge decode")) return;
+        }
+    free(w), free(codes);
+}
+
+/* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero,
+ * not summing to 1): the vector lanes must hand them to the scalar code. Not here: sums near 0
+ * (denormal weights, w and -w), which scale x past 2^63, where the scalar fast path is
+ * undefined (the int64 conversion overflows). */
+static void odd_weights(void)
+{
+    const float odd[] = {-1e-3f, -0.0f, 0.0f, NAN, INFINITY, -INFINITY, 0.5f, 2.0f, 1.0f, 0.75f};
+    size_t count = 40000;
+    float* w = malloc(count * 4 * sizeof(float));
+    for (uint32_t k = 2; k <= 4; ++k) {
+        sp_codec c;
+        /* a small grid: the scalar general path spends O(s) on weights that sum to 0 or NaN */
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 10, &c) == SP_OK);
+        for (size_t v = 0; v < count; ++v) {
+            random_tuple(k, c.scale, w + v * k);
+            for (uint32_t i = 0; i < k; ++i)
+                if (rng_next() % 4 == 0) w[v * k + i] = odd[rng_next() % (sizeof(odd) / sizeof(odd[0]))];
+        }
+        compare_encode(&c, w, count, "odd encode");
+    }
+    free(w);
+}
+
+/* Counts around the block size and pointers off 16/32-byte alignment. */
+static void counts_and_alignment(void)
+{
+    float w[4 * 40 + 4];
+    uint64_t codes[40 + 2];
+    for (uint32_t k = 2; k <= 4; ++k) {
+        sp_codec c;
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
+        for (size_t offset = 0; offset < 3; ++offset)
+            for (size_t count = 0; count <= 33; ++count) {
+                for (size_t v = 0; v < count; ++v) random_tuple(k, c.scale, w + offset + v * k);
+                compare_encode(&c, w + offset, count, "count encode");
+                for (size_t v = 0; v < count; ++v) codes[offset + v] = rng_next() % (c.max_code + 1);
+                compare_decode(&c, codes + offset, count, "count decode");
+            }
+        /* a zero count with null pointers is fine */
+        CHECK(sp_encode_weights_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
+        CHECK(sp_decode_weights_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
+    }
+}
+
+/* An invalid code anywhere in a block: the first one is reported, every vertex before it is
+ * decoded as the scalar path decodes it, and none after it is written. */
+static void invalid_codes(void)
+{
+    enum { COUNT = 24 };
+    for (uint32_t k = 2; k <= 4; ++k) {
+        sp_codec c;
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
+        for (size_t at = 0; at < COUNT; ++at)
+            for (int pass = 0; pass < 2; ++pass) {
+                uint64_t codes[COUNT];
+                float w[COUNT * 4], ref[4];
+                for (size_t v = 0; v < COUNT; ++v) codes[v] = rng_next() % (c.max_code + 1);
+                codes[at] = pass ? UINT64_MAX : c.max_code + 1;
+                if (at + 3 < COUNT) codes[at + 3] = c.max_code + 7; /* a later one is not reported */
+                for (size_t i = 0; i < COUNT * 4; ++i) w[i] = -7.0f;
+                size_t bad = (size_t)-1;
+                CHECK(sp_decode_weights_batch(&c, codes, COUNT, w, &bad) == SP_ERR_CODE_OUT_OF_RANGE);
+                CHECK_MSG(bad == at, "K=%u invalid at %zu reported at %zu", k, at, bad);
+                for (size_t v = 0; v < COUNT; ++v) {
+                    if (v < at) {
+                        sp_decode_weights(&c, codes[v], ref);
+                        CHECK(memcmp(w + v * k, ref, k * sizeof(float)) == 0);
+                    } else {
+                        for (uint32_t i = 0; i < k; ++i) CHECK(w[v * k + i] == -7.0f);
+                    }
+                }
+            }
+    }
+}
+
+int main(void)
+{
+    exhaustive_small();
+    counts_and_alignment();
+    invalid_codes();
+    odd_weights();
+    range_edges();
+    random_tuples();
+    return check_report("test_batch");
+}
