@@ -69,6 +69,7 @@ def arguments():
     parser.add_argument("--validator", default="")
     parser.add_argument("--cli", default="")
     args = parser.parse_args(argv)
+    args.out = os.path.abspath(args.out)  # Blender's save operator refuses relative paths
     os.makedirs(args.out, exist_ok=True)
     return args
 
