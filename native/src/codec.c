@@ -348,12 +348,12 @@ static int code_is_valid(const sp_codec* codec, uint64_t code)
     return 1;
 }
 
-sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
-                                  uint64_t* codes, uint8_t* significant)
+sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weights, size_t vertex_count,
+                                      uint64_t* codes, uint8_t* significant, sp_oss_isa widest)
 {
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
-    size_t first = sp_oss_encode_batch(codec, weights, vertex_count, codes, significant); /* vector prefix */
+    size_t first = sp_oss_encode_batch(codec, weights, vertex_count, codes, significant, widest); /* vector prefix */
 #define SP_ENCODE_LOOP(K)                                                                            \
     for (size_t v = first; v < vertex_count; ++v)                                                   \
         codes[v] = encode_one(codec, weights + v * (K), (K), significant ? significant + v : NULL);
@@ -367,12 +367,12 @@ sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, s
     return SP_OK;
 }
 
-sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count, float* weights,
-                                  size_t* error_vertex)
+sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,
+                                      float* weights, size_t* error_vertex, sp_oss_isa widest)
 {
     if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
-    size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights); /* vector prefix */
+    size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights, widest); /* vector prefix */
     for (size_t v = first; v < vertex_count; ++v) {
         if (!code_is_valid(codec, codes[v])) {
             if (error_vertex) *error_vertex = v;
@@ -381,4 +381,16 @@ sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, 
         sp_decode_weights(codec, codes[v], weights + v * k);
     }
     return SP_OK;
+}
+
+sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
+                                  uint64_t* codes, uint8_t* significant)
+{
+    return sp_encode_weights_batch_isa(codec, weights, vertex_count, codes, significant, SP_OSS_ISA_AVX512);
+}
+
+sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count, float* weights,
+                                  size_t* error_vertex)
+{
+    return sp_decode_weights_batch_isa(codec, codes, vertex_count, weights, error_vertex, SP_OSS_ISA_AVX512);
 }

@@ -1,5 +1,6 @@
 /*
- * Vectorised batch encode and decode of OSS for K = 2..4 (AVX2, four vertices per step).
+ * Vectorised batch encode and decode of OSS for K = 2..4 (AVX2, four vertices per step), and
+ * the dispatch between it and the AVX-512 path (codec_oss_batch_avx512.c, eight per step).
  *
  * Results are bit-identical to the scalar path (sp_grid_quantize + sp_oss_pack, and
  * sp_oss_unpack + the double-to-float conversion of sp_decode_weights): the rounding runs in
@@ -31,10 +32,11 @@ static int batch_supported(const sp_codec* codec)
 
 #if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
+#endif
 
 /* The scalar encode of one vertex, as the batch loop in codec.c does it: the reference the
  * vector lanes fall back to. */
-static uint64_t encode_scalar(const sp_codec* codec, const float* weights, uint8_t* significant)
+uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
 {
     uint64_t q[SP_MAX_INFLUENCES] = {0};
     uint32_t k = codec->influences;
@@ -46,6 +48,8 @@ static uint64_t encode_scalar(const sp_codec* codec, const float* weights, uint8
     }
     return sp_oss_pack(codec->n, k, q);
 }
+
+#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
 
 /* No "fma": a fused multiply-add would round differently from the scalar code. */
 #define SP_AVX2 __attribute__((target("avx2")))
@@ -208,7 +212,7 @@ static inline __attribute__((always_inline)) SP_AVX2 void encode_chunk(const sp_
         }
         int slow = ~_mm256_movemask_pd(ok[b]) & 15;
         for (size_t lane = v; slow; ++lane, slow >>= 1)
-            if (slow & 1) codes[lane] = encode_scalar(codec, weights + lane * k, significant ? significant + lane : NULL);
+            if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
     }
 }
 
@@ -304,17 +308,6 @@ static inline SP_AVX2 __m256d layer_estimate4(double n, __m256d argument)
     return clamp_floor(estimate, splat((double)(((uint64_t)n + 1) / 2 - 1)));
 }
 
-/* u(k), clearing the lanes of *ok where u(k) <= code < u(k + 1) fails. Layer k < layers is a
- * triangle of N - 2k bottom samples, so u(k + 1) = u(k) + S(N - 2k). */
-static inline SP_AVX2 __m256d layer_check4(double n, __m256d k, __m256d code, __m256d* ok)
-{
-    __m256d lo = layer_base4(splat(n), k), bottom = _mm256_sub_pd(splat(n), _mm256_add_pd(k, k));
-    __m256d triangle = _mm256_add_pd(_mm256_mul_pd(_mm256_add_pd(bottom, splat(1.0)), bottom), splat(1.0));
-    __m256d hi = _mm256_add_pd(lo, floor_div(triangle, 3.0));
-    *ok = _mm256_and_pd(*ok, _mm256_and_pd(_mm256_cmp_pd(lo, code, _CMP_LE_OQ), _mm256_cmp_pd(code, hi, _CMP_LT_OQ)));
-    return lo;
-}
-
 /* (float)(q * (1/s)) per component, as grid_to_weights does, stored as four vertices. */
 static inline SP_AVX2 void store_block(const __m256d* q, uint32_t k, double inverse, float* out)
 {
@@ -351,7 +344,12 @@ static inline __attribute__((always_inline)) SP_AVX2 void decode_chunk(const sp_
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) layer[b] = layer_root_argument4(n, code[b]);
         for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate4(n, layer[b]);
-        for (size_t b = 0; b < blocks; ++b) rest[b] = _mm256_sub_pd(code[b], layer_check4(n, layer[b], code[b], &ok[b]));
+        /* The layer needs no check of its own: with k clamped to the layers, the row check
+         * accepts only a rest = code - u(k) inside layer k's triangle (a negative rest fails
+         * s(j) <= rest, one past the triangle fails rest < s(j + 1) for every row, row
+         * j >= rows has s(j + 1) <= s(j)), and then (k, row, i) is the one tuple whose index
+         * is code. */
+        for (size_t b = 0; b < blocks; ++b) rest[b] = _mm256_sub_pd(code[b], layer_base4(splat(n), layer[b]));
     }
     if (k > 2)
         for (size_t b = 0; b < blocks; ++b)
@@ -434,15 +432,34 @@ static int has_avx2(void)
 }
 #endif
 
-size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                           uint8_t* significant)
+/* The widest path this CPU and the caller allow (__builtin_cpu_supports reads a cached word). */
+static sp_oss_isa batch_isa(sp_oss_isa widest)
 {
-    if (!batch_supported(codec) || !has_avx2()) return 0;
-    return encode_avx2(codec, weights, count, codes, significant);
+    sp_oss_isa cpu = sp_oss_has_avx512() ? SP_OSS_ISA_AVX512 : (has_avx2() ? SP_OSS_ISA_AVX2 : SP_OSS_ISA_SCALAR);
+    return cpu < widest ? cpu : widest;
 }
 
-size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
+/* AVX-512 takes blocks of 8, AVX2 what is left in blocks of 4 (the tail, or the rest after a
+ * block the AVX-512 loop stopped at), the scalar loop in codec.c the remainder. */
+size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                           uint8_t* significant, sp_oss_isa widest)
 {
-    if (!batch_supported(codec) || !has_avx2()) return 0;
-    return decode_avx2(codec, codes, count, weights);
+    sp_oss_isa isa = batch_supported(codec) ? batch_isa(widest) : SP_OSS_ISA_SCALAR;
+    size_t done = 0;
+    if (isa >= SP_OSS_ISA_AVX512) done = sp_oss_encode_avx512(codec, weights, count, codes, significant);
+    if (isa >= SP_OSS_ISA_AVX2)
+        done += encode_avx2(codec, weights + done * codec->influences, count - done, codes + done,
+                            significant ? significant + done : NULL);
+    return done;
+}
+
+size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                           sp_oss_isa widest)
+{
+    sp_oss_isa isa = batch_supported(codec) ? batch_isa(widest) : SP_OSS_ISA_SCALAR;
+    size_t done = 0;
+    if (isa >= SP_OSS_ISA_AVX512) done = sp_oss_decode_avx512(codec, codes, count, weights);
+    if (isa >= SP_OSS_ISA_AVX2)
+        done += decode_avx2(codec, codes + done, count - done, weights + done * codec->influences);
+    return done;
 }

@@ -1,20 +1,27 @@
 /*
  * Batch encode/decode against the single-vertex path, bit for bit. The batch functions take a
- * vector path for OSS (codec_oss_batch.c) on blocks of vertices and leave the tail and any odd
- * lane to the scalar code; a batch of one vertex is always scalar, so it is the reference.
+ * vector path for OSS (codec_oss_batch.c: AVX-512 blocks of 8, AVX2 blocks of 4) on blocks of
+ * vertices and leave the tail and any odd lane to the scalar code; a batch of one vertex is
+ * always scalar, so it is the reference. Every check runs once per vector path the CPU has.
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../../native/src/codec_internal.h" /* the *_isa batch forms: one path at a time */
 #include "check.h"
 #include "skinpack.h"
+
+/* The widest vector path the batch calls under test may take (main walks AVX-512, then AVX2). */
+static sp_oss_isa widest = SP_OSS_ISA_AVX512;
+#define encode_batch(c, w, n, codes, sig) sp_encode_weights_batch_isa(c, w, n, codes, sig, widest)
+#define decode_batch(c, codes, n, w, bad) sp_decode_weights_batch_isa(c, codes, n, w, bad, widest)
 
 /* Reference: each vertex on its own (a one-vertex batch never reaches the vector path). */
 static void encode_reference(const sp_codec* c, const float* w, size_t count, uint64_t* codes, uint8_t* sig)
 {
     for (size_t v = 0; v < count; ++v)
-        sp_encode_weights_batch(c, w + v * c->influences, 1, codes + v, sig + v);
+        encode_batch(c, w + v * c->influences, 1, codes + v, sig + v);
 }
 
 /* Batch-encodes count vertices and compares codes and significant counts with the reference;
@@ -28,8 +35,8 @@ static int compare_encode(const sp_codec* c, const float* w, size_t count, const
     uint8_t* ref_sig = malloc(count + 1);
     int before = check_failures;
     encode_reference(c, w, count, ref, ref_sig);
-    CHECK(sp_encode_weights_batch(c, w, count, codes, sig) == SP_OK);
-    CHECK(sp_encode_weights_batch(c, w, count, bare, NULL) == SP_OK);
+    CHECK(encode_batch(c, w, count, codes, sig) == SP_OK);
+    CHECK(encode_batch(c, w, count, bare, NULL) == SP_OK);
     for (size_t v = 0; v < count; ++v) {
         CHECK_MSG(codes[v] == ref[v] && bare[v] == ref[v], "%s K=%u N=%llu vertex %zu: %llu vs %llu (w %.9g %.9g %.9g %.9g)",
                   what, c->influences, (unsigned long long)c->n, v, (unsigned long long)codes[v],
@@ -50,7 +57,7 @@ static int compare_decode(const sp_codec* c, const uint64_t* codes, size_t count
     float* ref = malloc((count * k + 1) * sizeof(float));
     int before = check_failures;
     size_t bad = (size_t)-1;
-    CHECK(sp_decode_weights_batch(c, codes, count, w, &bad) == SP_OK);
+    CHECK(decode_batch(c, codes, count, w, &bad) == SP_OK);
     CHECK(bad == (size_t)-1);
     for (size_t v = 0; v < count; ++v) {
         sp_decode_weights(c, codes[v], ref + v * k);
@@ -81,7 +88,7 @@ static void exhaustive_small(void)
             float* w = malloc(count * k * sizeof(float));
             for (size_t v = 0; v < count; ++v) codes[v] = v;
             if (compare_decode(&c, codes, count, "exhaustive decode")) return;
-            CHECK(sp_decode_weights_batch(&c, codes, count, w, NULL) == SP_OK);
+            CHECK(decode_batch(&c, codes, count, w, NULL) == SP_OK);
             if (compare_encode(&c, w, count, "exhaustive encode")) return;
             for (int dir = -1; dir <= 1; dir += 2) {
                 for (size_t i = 0; i < count * k; ++i) w[i] = nextafterf(w[i], dir < 0 ? 0.0f : 1.0f);
@@ -135,16 +142,18 @@ static void random_tuples(void)
     free(w), free(codes);
 }
 
-/* N at and just past the largest the vector path accepts (exact there, scalar beyond), and
+/* N at and just past the largest the vector paths accept (exact there, scalar beyond), and
  * codes at every layer and row start/end there, where the root estimates are off by one. */
 static void range_edges(void)
 {
-    static const uint64_t limits[5] = {0, 0, (uint64_t)1 << 48, (uint64_t)1 << 23, (uint64_t)1 << 15};
+    static const struct { uint32_t k; uint64_t n; } edges[] = {
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 23}, {4, (uint64_t)1 << 15}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
-    for (uint32_t k = 2; k <= 4; ++k)
-        for (uint64_t n = limits[k] - 1; n <= limits[k] + 1; ++n) {
+    for (size_t e = 0; e < sizeof(edges) / sizeof(edges[0]); ++e)
+        for (uint64_t n = edges[e].n - 1; n <= edges[e].n + 1; ++n) {
+            uint32_t k = edges[e].k;
             sp_codec c = oss(k, n);
             for (size_t v = 0; v < count; ++v) random_tuple(k, c.scale, w + v * k);
             if (compare_encode(&c, w, count, "edge encode")) return;
@@ -155,6 +164,7 @@ static void range_edges(void)
                 if (k > 2 && v % 3 == 0) code = base + sp_oss_row_base(bottom, row);  /* row start */
                 if (k > 2 && v % 3 == 1) code = base + sp_oss_row_base(bottom, row + 1) - 1; /* row end */
                 if (k == 4 && v % 7 == 0) code = base - (layer > 0);                  /* layer end */
+                if (k == 4 && v % 11 == 0) code = base;                               /* layer start */
                 codes[v] = code;
             }
             if (compare_decode(&c, codes, count, "edge decode")) return;
@@ -188,21 +198,21 @@ static void odd_weights(void)
 /* Counts around the block size and pointers off 16/32-byte alignment. */
 static void counts_and_alignment(void)
 {
-    float w[4 * 40 + 4];
-    uint64_t codes[40 + 2];
+    float w[4 * 72 + 4];
+    uint64_t codes[72 + 2];
     for (uint32_t k = 2; k <= 4; ++k) {
         sp_codec c;
         CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
         for (size_t offset = 0; offset < 3; ++offset)
-            for (size_t count = 0; count <= 33; ++count) {
+            for (size_t count = 0; count <= 70; ++count) { /* chunks, blocks of 8 and 4, tails */
                 for (size_t v = 0; v < count; ++v) random_tuple(k, c.scale, w + offset + v * k);
                 compare_encode(&c, w + offset, count, "count encode");
                 for (size_t v = 0; v < count; ++v) codes[offset + v] = rng_next() % (c.max_code + 1);
                 compare_decode(&c, codes + offset, count, "count decode");
             }
         /* a zero count with null pointers is fine */
-        CHECK(sp_encode_weights_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
-        CHECK(sp_decode_weights_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
+        CHECK(encode_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
+        CHECK(decode_batch(&c, NULL, 0, NULL, NULL) == SP_OK);
     }
 }
 
@@ -210,7 +220,7 @@ static void counts_and_alignment(void)
  * decoded as the scalar path decodes it, and none after it is written. */
 static void invalid_codes(void)
 {
-    enum { COUNT = 24 };
+    enum { COUNT = 44 }; /* past an AVX-512 chunk, into blocks of 8 and 4 */
     for (uint32_t k = 2; k <= 4; ++k) {
         sp_codec c;
         CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
@@ -223,7 +233,7 @@ static void invalid_codes(void)
                 if (at + 3 < COUNT) codes[at + 3] = c.max_code + 7; /* a later one is not reported */
                 for (size_t i = 0; i < COUNT * 4; ++i) w[i] = -7.0f;
                 size_t bad = (size_t)-1;
-                CHECK(sp_decode_weights_batch(&c, codes, COUNT, w, &bad) == SP_ERR_CODE_OUT_OF_RANGE);
+                CHECK(decode_batch(&c, codes, COUNT, w, &bad) == SP_ERR_CODE_OUT_OF_RANGE);
                 CHECK_MSG(bad == at, "K=%u invalid at %zu reported at %zu", k, at, bad);
                 for (size_t v = 0; v < COUNT; ++v) {
                     if (v < at) {
@@ -237,13 +247,40 @@ static void invalid_codes(void)
     }
 }
 
+/* The vertices each path takes in a batch of 23 (the scalar loop does the rest): a path that
+ * silently did nothing would pass every comparison above. */
+static void path_coverage(sp_oss_isa isa)
+{
+    float w[23 * 4];
+    uint64_t codes[23];
+    for (uint32_t k = 2; k <= 4; ++k) {
+        sp_codec c;
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
+        for (size_t v = 0; v < 23; ++v) random_tuple(k, c.scale, w + v * k);
+        size_t expected = 0;
+#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
+        if (isa >= SP_OSS_ISA_AVX512 && sp_oss_has_avx512()) expected = 16 + 4; /* two blocks of 8, one of 4 */
+        else if (isa >= SP_OSS_ISA_AVX2 && __builtin_cpu_supports("avx2")) expected = 20;
+#endif
+        CHECK_MSG(sp_oss_encode_batch(&c, w, 23, codes, NULL, isa) == expected, "K=%u isa %d encode prefix", k, (int)isa);
+        CHECK_MSG(sp_oss_decode_batch(&c, codes, 23, w, isa) == expected, "K=%u isa %d decode prefix", k, (int)isa);
+    }
+}
+
 int main(void)
 {
-    exhaustive_small();
-    counts_and_alignment();
-    invalid_codes();
-    odd_weights();
-    range_edges();
-    random_tuples();
+    /* AVX-512 (with AVX2 on its tail) first, then AVX2 alone; each falls to the next on CPUs
+     * without it, so the checks then merely repeat. */
+    static const sp_oss_isa paths[] = {SP_OSS_ISA_AVX512, SP_OSS_ISA_AVX2};
+    for (size_t p = 0; p < sizeof(paths) / sizeof(paths[0]); ++p) {
+        widest = paths[p];
+        path_coverage(paths[p]);
+        exhaustive_small();
+        counts_and_alignment();
+        invalid_codes();
+        odd_weights();
+        range_edges();
+        random_tuples();
+    }
     return check_report("test_batch");
 }
