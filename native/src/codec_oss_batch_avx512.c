@@ -3,9 +3,11 @@
  * eight double lanes, compare masks in mask registers, and the AoS weights moved in and out
  * with two-source permutes instead of per-lane inserts and extracts.
  *
- * Same arithmetic, same operation order as the AVX2 path (and so as the scalar code), the
- * same exactness argument (integers below 2^50 in double lanes) and the same rule: a lane the
- * vector code cannot prove exact is redone by the scalar code. See codec_oss_batch.c.
+ * Same arithmetic, same operation order as the AVX2 path (and so as the scalar code) for every
+ * value that reaches the output, the same exactness argument (integers below 2^50 in double
+ * lanes) and the same rule: a lane the vector code cannot prove exact is redone by the scalar
+ * code. See codec_oss_batch.c. Only decode's layer and row *estimates* differ (rcp14/rsqrt14
+ * with explicit FMAs, a shifted row estimate): the exact integer checks decide every lane.
  */
 #include "codec_internal.h"
 
@@ -237,10 +239,12 @@ static inline SP_AVX512 __m512d clamp_floor8(__m512d e, __m512d top)
     return _mm512_min_pd(_mm512_max_pd(floor8(e), _mm512_setzero_pd()), top);
 }
 
-/* c + 1/c for c = cbrt(x), x >= 1, to ~1e-13 (cube_root_plus_inverse4 of the AVX2 path in
- * eight lanes): the float exponent/3 bit trick, a Halley step in float, one in double whose
- * division also yields 1/c. (Division-free Newton steps on x^(-1/3) in float measured ~10%
- * slower on Zen 4 despite fewer operations: a longer dependency chain.) */
+/* c + 1/c for c = cbrt(x), x >= 1, to ~1e-11 relative: the float exponent/3 bit trick and a
+ * Halley step in float (~1e-7), then one Newton step in double whose 1/(3y^2) comes from
+ * rcp14 (its 2^-14 error only scales the already tiny correction), and 1/c from rcp14 with
+ * one Newton refinement (~2^-28). An estimate only: the exact integer checks catch any miss,
+ * so these steps may use rcp14 and explicit FMAs freely; no zmm division or square root
+ * (those were the bottleneck of the previous double Halley step). */
 static inline SP_AVX512 __m512d cube_root_plus_inverse8(__m512d x)
 {
     __m256 xf = _mm512_cvtpd_ps(x);
@@ -249,17 +253,35 @@ static inline SP_AVX512 __m512d cube_root_plus_inverse8(__m512d x)
     __m256 yf3 = _mm256_mul_ps(_mm256_mul_ps(yf, yf), yf);
     yf = _mm256_div_ps(_mm256_mul_ps(yf, _mm256_add_ps(yf3, _mm256_add_ps(xf, xf))), _mm256_add_ps(_mm256_add_ps(yf3, yf3), xf));
     __m512d y = _mm512_cvtps_pd(yf);
-    __m512d y3 = _mm512_mul_pd(_mm512_mul_pd(y, y), y);
-    __m512d yn = _mm512_mul_pd(y, _mm512_add_pd(y3, _mm512_add_pd(x, x))), d = _mm512_add_pd(_mm512_add_pd(y3, y3), x);
-    return _mm512_div_pd(_mm512_add_pd(_mm512_mul_pd(yn, yn), _mm512_mul_pd(d, d)), _mm512_mul_pd(yn, d));
+    __m512d y2 = _mm512_mul_pd(y, y);
+    __m512d r = _mm512_rcp14_pd(_mm512_mul_pd(y2, splat(3.0)));
+    __m512d c = _mm512_fnmadd_pd(_mm512_fmsub_pd(y2, y, x), r, y); /* y - (y^3 - x) / (3y^2) */
+    __m512d ic = _mm512_rcp14_pd(c);
+    ic = _mm512_mul_pd(ic, _mm512_fnmadd_pd(c, ic, splat(2.0)));
+    return _mm512_add_pd(c, ic);
 }
 
-/* oss_find_row's mirrored square root estimate, floored and clamped to the triangle's rows.
- * (A float square root measured no faster than this double one.) */
+/* sqrt(x) for x > 0 to ~2^-28 relative (rsqrt14 and one refinement); NaN for x <= 0 or
+ * x = inf. Only for estimates the exact checks verify. */
+static inline SP_AVX512 __m512d sqrt_estimate8(__m512d x)
+{
+    __m512d r = _mm512_rsqrt14_pd(x);
+    __m512d s = _mm512_mul_pd(x, r);
+    return _mm512_fmadd_pd(_mm512_mul_pd(r, splat(0.5)), _mm512_fnmadd_pd(s, s, x), s); /* s + (x - s^2) / (2 sqrt x) */
+}
+
+/* oss_find_row's mirrored square root estimate for w + 7/8 instead of w, floored and clamped
+ * to the triangle's rows. s(j) = floor(s~(j)) with s~(j) - s(j) in {0, 1/4, 1/2, 3/4}, so
+ * w = s(j) lies up to 3/4 below the smooth s~(j) and the unshifted estimate floors to j - 1
+ * there (the ~0.2% of lanes the scalar code used to redo); w + 7/8 lies strictly between
+ * s~(j) and s~(j + 1) for every w of row j, so in exact arithmetic the estimate is the row.
+ * 12 (w + 7/8) = 12 w + 10.5: mirrored = apex^2 + 3 - 10.5 - 12 w. The exact check still
+ * decides; the correctly rounded sqrt keeps the rounding error far below the 1/8 margin (an
+ * rsqrt14 estimate measured slower and missed more for large N). */
 static inline SP_AVX512 __m512d row_estimate8(__m512d bottom, __m512d w)
 {
     __m512d apex = _mm512_add_pd(_mm512_add_pd(bottom, bottom), splat(1.0));
-    __m512d mirrored = _mm512_sub_pd(_mm512_add_pd(_mm512_mul_pd(apex, apex), splat(3.0)), _mm512_mul_pd(w, splat(12.0)));
+    __m512d mirrored = _mm512_sub_pd(_mm512_sub_pd(_mm512_mul_pd(apex, apex), splat(7.5)), _mm512_mul_pd(w, splat(12.0)));
     __m512d estimate = _mm512_mul_pd(_mm512_sub_pd(apex, _mm512_sqrt_pd(mirrored)), splat(1.0 / 3.0));
     __m512d last = _mm512_sub_pd(floor_div8(apex, 3.0), splat(1.0)); /* rows - 1 */
     return clamp_floor8(estimate, last);
@@ -283,7 +305,7 @@ static inline SP_AVX512 __m512d layer_estimate8(double n, __m512d code)
 {
     double m = n + 1;
     __m512d v = _mm512_sub_pd(splat(4 * m * m * m + 6 * m * m + 16), _mm512_mul_pd(code, splat(72.0)));
-    __m512d root = _mm512_maskz_sqrt_pd(_mm512_cmp_pd_mask(v, splat(2.0), _CMP_GT_OQ), _mm512_mul_pd(v, _mm512_sub_pd(v, splat(2.0))));
+    __m512d root = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(v, splat(2.0), _CMP_GT_OQ), sqrt_estimate8(_mm512_mul_pd(v, _mm512_sub_pd(v, splat(2.0)))));
     __m512d c = cube_root_plus_inverse8(_mm512_add_pd(_mm512_sub_pd(v, splat(1.0)), root));
     __m512d estimate = _mm512_mul_pd(_mm512_sub_pd(splat(2 * n + 3), c), splat(0.25));
     return clamp_floor8(estimate, splat((double)(((uint64_t)n + 1) / 2 - 1)));
