@@ -319,32 +319,30 @@ void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
     }
 }
 
-/* A code an encoder can write: in range and, for the grid methods, a sorted grid point
- * (encoders only write sorted tuples; the AABB codecs also have codes outside the simplex). */
-static int code_is_valid(const sp_codec* codec, uint64_t code)
+/* Decodes one code into weights (K floats) if an encoder can have written it: in range and,
+ * for the grid methods, a sorted grid point (the AABB codecs also have codes outside the
+ * simplex). Unpacks once; returns 0 and leaves weights untouched for an invalid code. */
+static int decode_valid(const sp_codec* codec, uint64_t code, float* weights)
 {
     uint32_t k = codec->influences;
+    float decoded[SP_MAX_INFLUENCES];
     if (code > codec->max_code) return 0;
-    if (k == 1 || codec->method == SP_METHOD_OSS) return 1;
-    if (codec->method == SP_METHOD_ANY) {
-        float w[SP_MAX_INFLUENCES];
-        sp_any_decode(codec, code, w);
-        return w[0] >= -1e-6f;
+    if (k == 1 || codec->method == SP_METHOD_ANY) {
+        sp_decode_weights(codec, code, decoded);
+        if (decoded[0] < -1e-6f) return 0; /* Any: the stored weights sum past 1 */
+    } else {
+        uint64_t q[SP_MAX_INFLUENCES] = {0};
+        if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);
+        else sp_grid_unpack(codec, code, q); /* clamps q[0] at 0, so a sum past s shows below */
+        sp_u128 sum = q[0];
+        for (uint32_t i = 1; i < k; ++i) {
+            if (q[i] > q[i - 1]) return 0;
+            sum += q[i];
+        }
+        if (sum != codec->scale) return 0;
+        grid_to_weights(q, k, codec->scale, decoded);
     }
-    uint64_t q[SP_MAX_INFLUENCES] = {0};
-    uint32_t shift = 0, first = codec->method == SP_METHOD_FIXED ? 0 : 1;
-    sp_u128 sum = 0;
-    for (uint32_t i = first, c = 0; i < k; ++i, ++c) {
-        uint32_t bits = codec->component_bits[c];
-        uint64_t mask = bits >= 64 ? UINT64_MAX : (((uint64_t)1 << bits) - 1);
-        q[i] = shift < 64 ? (code >> shift) & mask : 0;
-        shift += bits;
-        sum += q[i];
-    }
-    if (codec->method == SP_METHOD_FIXED ? sum != codec->scale : sum > codec->scale) return 0;
-    if (first) q[0] = codec->scale - (uint64_t)sum;
-    for (uint32_t i = 1; i < k; ++i)
-        if (q[i] > q[i - 1]) return 0;
+    for (uint32_t i = 0; i < k; ++i) weights[i] = decoded[i];
     return 1;
 }
 
@@ -374,11 +372,10 @@ sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* cod
     uint32_t k = codec->influences;
     size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights, widest); /* vector prefix */
     for (size_t v = first; v < vertex_count; ++v) {
-        if (!code_is_valid(codec, codes[v])) {
+        if (!decode_valid(codec, codes[v], weights + v * k)) {
             if (error_vertex) *error_vertex = v;
             return SP_ERR_CODE_OUT_OF_RANGE;
         }
-        sp_decode_weights(codec, codes[v], weights + v * k);
     }
     return SP_OK;
 }

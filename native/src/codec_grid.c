@@ -106,6 +106,6 @@ void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q)
         if (i > 0) rest = rest >= q[i] ? rest - q[i] : 0;
     }
     /* Cube/POT drop the largest weight: it is whatever the grid has left (0 for the invalid
-     * tuples of the AABB corners, which no encoder writes and sp_code_is_valid rejects). */
+     * tuples of the AABB corners, which no encoder writes and the validating decode rejects). */
     if (codec->method != SP_METHOD_FIXED) q[0] = rest;
 }
