@@ -116,6 +116,7 @@ class MeshletOptions(ctypes.Structure):
         ("max_joints", ctypes.c_uint32),
         ("min_group_triangles", ctypes.c_uint32),
         ("joint_cost", ctypes.c_float),
+        ("tuple_cost", ctypes.c_float),
     ]
 
 

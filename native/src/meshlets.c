@@ -15,6 +15,7 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->max_joints = 32;
     options->min_group_triangles = 16;
     options->joint_cost = 1.0f;
+    options->tuple_cost = 0.25f;
 }
 
 static size_t align8(size_t bytes)
@@ -28,19 +29,9 @@ size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_coun
            align8(vertex_count) + align8(SP_JOINT_SLOT_COUNT) + align8(max_triangles * sizeof(uint32_t));
 }
 
-/* The statistics count unique tuples in an open-addressing hash set of u64 keys, after the
- * builder is done with its scratch: at least twice as many slots as vertices. */
-static size_t tuple_set_slots(size_t vertex_count)
-{
-    size_t slots = 16;
-    while (slots < vertex_count * 2)
-        slots *= 2;
-    return slots;
-}
-
 static size_t stats_scratch_bound(size_t vertex_count)
 {
-    return tuple_set_slots(vertex_count) * sizeof(uint64_t);
+    return sp_meshlet_tuple_set_slots(vertex_count) * sizeof(uint64_t);
 }
 
 static size_t builder_scratch_bound(uint32_t builder, size_t triangle_count, size_t vertex_count)
@@ -81,7 +72,8 @@ static sp_result check_options(const sp_meshlet_options* o)
 {
     if (o->builder >= SP_MESHLETS_BUILDER_COUNT || o->max_vertices < 3 || o->max_vertices > SP_MESHLET_MAX_VERTICES ||
         o->max_triangles < 1 || o->max_triangles > SP_MESHLET_MAX_TRIANGLES || o->max_joints < 1 ||
-        o->max_joints > SP_MESHLET_MAX_JOINTS || !(o->joint_cost >= 0.0f && o->joint_cost <= 1000.0f))
+        o->max_joints > SP_MESHLET_MAX_JOINTS || !(o->joint_cost >= 0.0f && o->joint_cost <= 1000.0f) ||
+        !(o->tuple_cost >= 0.0f && o->tuple_cost <= 1000.0f))
         return SP_ERR_INVALID_ARGUMENT;
     return SP_OK;
 }
@@ -121,29 +113,38 @@ static void setup_scratch(sp_meshlet_context* ctx, void* scratch, size_t scratch
 
 #define EMPTY_SLOT UINT64_MAX
 
-/* Unique K-joint tuples over the mesh, with the same rule as the local LUTs (zero-weight
- * slots read as joint 0): the baseline a global tuple index needs. */
-static size_t count_global_tuples(const sp_meshlet_context* ctx, uint64_t* set)
+size_t sp_meshlet_tuple_set_slots(size_t vertex_count)
 {
-    size_t k = ctx->influences, slots = tuple_set_slots(ctx->vertex_count), unique = 0;
-    int saw_empty_key = 0; /* four joints 0xffff would read as an empty slot: counted apart */
+    size_t slots = 16;
+    while (slots < vertex_count * 2)
+        slots *= 2;
+    return slots;
+}
+
+size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32_t* ids)
+{
+    size_t k = ctx->influences, slots = sp_meshlet_tuple_set_slots(ctx->vertex_count), unique = 0;
+    int saw_empty_key = 0; /* four joints 0xffff would read as an empty slot: id `slots`, counted apart */
     memset(set, 0xff, slots * sizeof(uint64_t));
     for (size_t v = 0; v < ctx->vertex_count; ++v) {
         uint64_t key = 0;
         for (size_t s = 0; s < k; ++s)
             key = key << 16 | (ctx->weights[v * k + s] > 0.0f ? ctx->joints[v * k + s] : 0u);
+        size_t at = slots;
         if (key == EMPTY_SLOT) {
             unique += !saw_empty_key;
             saw_empty_key = 1;
-            continue;
+        } else {
+            at = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
+            while (set[at] != EMPTY_SLOT && set[at] != key)
+                at = (at + 1) & (slots - 1);
+            if (set[at] == EMPTY_SLOT) {
+                set[at] = key;
+                ++unique;
+            }
         }
-        size_t at = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
-        while (set[at] != EMPTY_SLOT && set[at] != key)
-            at = (at + 1) & (slots - 1);
-        if (set[at] == EMPTY_SLOT) {
-            set[at] = key;
-            ++unique;
-        }
+        if (ids)
+            ids[v] = (uint32_t)at;
     }
     return unique;
 }
@@ -177,7 +178,7 @@ static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)
     }
     if (ctx->used.vertices)
         stats->local_tuple_bits_mean = local_bits / ctx->used.vertices;
-    stats->global_tuples = count_global_tuples(ctx, (uint64_t*)ctx->builder_scratch);
+    stats->global_tuples = sp_meshlet_tuple_ids(ctx, (uint64_t*)ctx->builder_scratch, NULL);
     stats->global_tuple_bits = sp_index_bits(stats->global_tuples);
 }
 

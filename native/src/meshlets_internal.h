@@ -53,6 +53,13 @@ size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_coun
 size_t sp_meshlet_common_builder_scratch_bound(size_t triangle_count);
 size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count);
 
+/* Unique K-joint tuples over the mesh, with the same rule as the local LUTs (zero-weight slots
+ * read as joint 0), in an open-addressing set of sp_meshlet_tuple_set_slots(vertex_count) u64s.
+ * Returns how many; ids (optional, vertex_count entries) gets each vertex's tuple as a number
+ * below slots + 1, equal for equal tuples. */
+size_t sp_meshlet_tuple_set_slots(size_t vertex_count);
+size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32_t* ids);
+
 /* Fills triangle_joints; fails with SP_ERR_LIMIT_EXCEEDED naming the first triangle over max_joints. */
 sp_result sp_meshlet_collect_triangle_joints(sp_meshlet_context* ctx, size_t* error_triangle);
 

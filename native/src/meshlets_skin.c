@@ -7,8 +7,9 @@
  * centroids, where meshoptimizer uses a k-d tree) continues it. The score adds skinning to
  * meshoptimizer's: a candidate costs its topological priority (0 if it adds no vertex, 1 if it
  * completes a vertex's fan, else new vertices + 1) plus joint_cost per joint it would add to the
- * palette, so a meshlet fills up inside one region of the skeleton before it crosses into the
- * next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet
+ * palette and tuple_cost per tuple its new vertices would add to the local LUT, so a meshlet
+ * fills up inside one region of the skeleton (and one band of a blend) before it crosses into
+ * the next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet
  * is closed when no adjacent triangle fits a limit, and the next one starts from the best of
  * those misfits, so consecutive meshlets stay neighbours and leave no scattered leftovers.
  */
@@ -33,6 +34,10 @@ typedef struct skin_state {
     uint32_t* rank;             /* triangle -> position in morton[] */
     size_t seed_cursor;         /* morton[] before this position is all emitted */
     uint32_t last_rank;         /* rank of the triangle added last */
+    uint32_t* vertex_tuple;     /* vertex_count: global tuple id (sp_meshlet_tuple_ids) */
+    uint32_t* tuple_stamp;      /* per tuple id: open_stamp while the open meshlet has the tuple */
+    uint32_t open_stamp;        /* changes with every meshlet */
+    uint32_t open_tuple_count;  /* distinct tuples of the open meshlet's vertices */
 } skin_state;
 
 static size_t align8(size_t bytes)
@@ -42,9 +47,12 @@ static size_t align8(size_t bytes)
 
 size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
 {
+    size_t tuple_slots = sp_meshlet_tuple_set_slots(vertex_count);
     return align8((vertex_count + 1) * sizeof(uint32_t)) + align8(triangle_count * 3 * sizeof(uint32_t)) +
            align8(vertex_count * sizeof(uint32_t)) + align8(triangle_count) + align8(triangle_count * 3 * sizeof(float)) +
-           align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t));
+           align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t)) +
+           align8(vertex_count * sizeof(uint32_t)) + align8((tuple_slots + 1) * sizeof(uint32_t)) +
+           align8(tuple_slots * sizeof(uint64_t));
 }
 
 static void* carve(unsigned char** cursor, size_t bytes)
@@ -149,6 +157,13 @@ static float distance_to(const skin_state* s, uint32_t t, const float* point)
 /* Adds t to the open meshlet and takes it out of its vertices' live lists. */
 static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
 {
+    for (int c = 0; c < 3; ++c) {
+        uint32_t v = ctx->indices[t * 3 + c];
+        if (ctx->vertex_slot[v] == SP_MESHLET_NO_SLOT && s->tuple_stamp[s->vertex_tuple[v]] != s->open_stamp) {
+            s->tuple_stamp[s->vertex_tuple[v]] = s->open_stamp;
+            s->open_tuple_count++;
+        }
+    }
     sp_meshlet_add(ctx, t);
     s->emitted[t] = 1;
     s->last_rank = s->rank[t];
@@ -166,9 +181,37 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
     }
 }
 
+/* Closes the open meshlet. */
+static void flush(sp_meshlet_context* ctx, skin_state* s)
+{
+    sp_meshlet_flush(ctx);
+    s->open_stamp++;
+    s->open_tuple_count = 0;
+}
+
+/* Tuples triangle t would add to the open meshlet's local LUT. */
+static uint32_t new_tuples(const sp_meshlet_context* ctx, const skin_state* s, uint32_t t)
+{
+    const uint32_t* tri = ctx->indices + (size_t)t * 3;
+    uint32_t fresh[3], count = 0;
+    for (int c = 0; c < 3; ++c) {
+        if (ctx->vertex_slot[tri[c]] != SP_MESHLET_NO_SLOT)
+            continue;
+        uint32_t id = s->vertex_tuple[tri[c]];
+        if (s->tuple_stamp[id] == s->open_stamp)
+            continue;
+        uint32_t seen = 0;
+        while (seen < count && fresh[seen] != id)
+            ++seen;
+        if (seen == count)
+            fresh[count++] = id;
+    }
+    return count;
+}
+
 typedef struct candidate {
     uint32_t triangle;
-    float cost;     /* priority + joint_cost * new joints: lower is better */
+    float cost;     /* priority + joint_cost * new joints + tuple_cost * new tuples: lower is better */
     float distance; /* squared, centroid to the meshlet's centroid: meshopt's tie-break */
 } candidate;
 
@@ -193,8 +236,8 @@ static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_
 }
 
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
- * limit. The joint term is never negative, so a candidate whose topology alone is worse than
- * the best so far is skipped before its joints are counted. */
+ * limit. The joint and tuple terms are never negative, so a candidate whose topology alone is
+ * worse than the best so far is skipped before they are counted. */
 static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
 {
     candidate best = {NO_TRIANGLE, 0.0f, 0.0f};
@@ -217,7 +260,8 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
-            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            float cost = priority + ctx->options.joint_cost * (float)new_joints +
+                         ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             candidate c = {t, cost, distance_to(s, t, point)};
@@ -278,6 +322,13 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.rank = carve(&cursor, t_count * sizeof(uint32_t));
     s.seed_cursor = 0;
     s.last_rank = 0;
+    s.vertex_tuple = carve(&cursor, v_count * sizeof(uint32_t));
+    size_t tuple_slots = sp_meshlet_tuple_set_slots(v_count);
+    s.tuple_stamp = carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
+    sp_meshlet_tuple_ids(ctx, carve(&cursor, tuple_slots * sizeof(uint64_t)), s.vertex_tuple);
+    memset(s.tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
+    s.open_stamp = 1;
+    s.open_tuple_count = 0;
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     build_spatial_order(ctx, &s);
@@ -295,7 +346,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         candidate any = best_neighbour(ctx, &s, 0);
         if (any.triangle != NO_TRIANGLE) {
             /* the patch goes on but the meshlet is full: the next meshlet continues from here */
-            sp_meshlet_flush(ctx);
+            flush(ctx, &s);
             emit(ctx, &s, any.triangle);
             continue;
         }
@@ -308,7 +359,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
             ctx->open_triangle_count < ctx->options.max_triangles)
             near = nearest_free(ctx, &s, point, 1);
         if (near == NO_TRIANGLE) {
-            sp_meshlet_flush(ctx);
+            flush(ctx, &s);
             near = nearest_free(ctx, &s, point, 0);
         }
         emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));

@@ -50,6 +50,7 @@ int main(void) {
     FIELD(sp_meshlet_options, builder); FIELD(sp_meshlet_options, max_vertices);
     FIELD(sp_meshlet_options, max_triangles); FIELD(sp_meshlet_options, max_joints);
     FIELD(sp_meshlet_options, min_group_triangles); FIELD(sp_meshlet_options, joint_cost);
+    FIELD(sp_meshlet_options, tuple_cost);
     END();
     BEGIN(sp_meshlet);
     FIELD(sp_meshlet, vertex_offset); FIELD(sp_meshlet, triangle_offset); FIELD(sp_meshlet, joint_offset);

@@ -1,11 +1,13 @@
 /*
  * test_meshlets_assets.c - every builder at several limits on real skinned meshes exported by
  * export_mesh_data.py (label "meshlets"): the full meshlet_check on each output, determinism of
- * each builder (at 64/124/32), and the palette-limit error on a limit below the mesh's widest
- * triangle.
+ * each builder (at 64/124/32), the palette-limit error on a limit below the mesh's widest
+ * triangle, and that no builder's split goes below the joint lower bound (joint_bound.h) that
+ * the benchmark uses to judge the joints-per-meshlet target.
  *
  *   test_meshlets_assets FILE.spmd...
  */
+#include "joint_bound.h"
 #include "mesh_data.h"
 #include "meshlet_check.h"
 
@@ -37,6 +39,15 @@ static int check_file(const char* path)
             meshlet_run_build(&run, &in, &o);
             char message[256] = "";
             int ok = meshlet_check(&run, &in, &o, message, sizeof(message));
+            joint_bound bound;
+            double palette_sum = run.stats.mean_joints * (double)run.stats.meshlet_count;
+            if (!joint_bound_compute(&in, o.max_vertices, o.max_triangles, &bound))
+                return failures + 1;
+            if (run.result == SP_OK && palette_sum + 0.5 < (double)bound.palette_sum) {
+                snprintf(message, sizeof(message), "%.0f palette entries, below the lower bound %zu", palette_sum,
+                         bound.palette_sum);
+                ok = 0;
+            }
             int same = 1;
             if (l == 0) { /* determinism: once per builder, at the default limits */
                 meshlet_run_build(&again, &in, &o);

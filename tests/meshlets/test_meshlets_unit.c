@@ -3,6 +3,7 @@
  * run under ASan/UBSan): every builder's output is checked in full by meshlet_check, plus the
  * thesis baselines' defining behaviour, determinism, the palette-limit error and bad arguments.
  */
+#include "joint_bound.h"
 #include "meshlet_check.h"
 
 #include <math.h>
@@ -405,6 +406,11 @@ static void test_invalid_arguments(void)
     EXPECT(build_with(&grid, grid.indices, grid.index_count, 12, K, &negative, &run, 0) == SP_ERR_INVALID_ARGUMENT,
            "negative joint cost");
     meshlet_run_free(&run);
+    negative = good;
+    negative.tuple_cost = -1.0f;
+    EXPECT(build_with(&grid, grid.indices, grid.index_count, 12, K, &negative, &run, 0) == SP_ERR_INVALID_ARGUMENT,
+           "negative tuple cost");
+    meshlet_run_free(&run);
     EXPECT(build_with(&grid, grid.indices, grid.index_count - 1, 12, K, &good, &run, 0) == SP_ERR_INVALID_ARGUMENT,
            "index count not a multiple of 3");
     meshlet_run_free(&run);
@@ -456,6 +462,122 @@ static void test_checker_catches_corruption(void)
     free_mesh(&grid);
 }
 
+/* Two rows of `columns` vertices; the left half weighted 1 to joint 0, the right half to joint 1,
+ * so only the middle quad's triangles touch both. */
+static mesh make_two_joint_strip(int columns)
+{
+    mesh m;
+    m.vertex_count = (size_t)columns * 2;
+    m.index_count = (size_t)(columns - 1) * 6;
+    m.positions = calloc(m.vertex_count * 3, sizeof(float));
+    m.indices = malloc(m.index_count * sizeof(uint32_t));
+    m.joints = calloc(m.vertex_count * K, sizeof(uint16_t));
+    m.weights = calloc(m.vertex_count * K, sizeof(float));
+    for (int x = 0; x < columns; ++x)
+        for (int y = 0; y < 2; ++y) {
+            size_t v = (size_t)x * 2 + y;
+            m.positions[v * 3] = (float)x;
+            m.positions[v * 3 + 1] = (float)y;
+            m.joints[v * K] = (uint16_t)(x >= columns / 2);
+            m.weights[v * K] = 1.0f;
+        }
+    for (int x = 0; x + 1 < columns; ++x) {
+        uint32_t a = (uint32_t)x * 2, quad[6] = {a, a + 2, a + 3, a, a + 3, a + 1};
+        memcpy(m.indices + (size_t)x * 6, quad, sizeof(quad));
+    }
+    return m;
+}
+
+/* An open tube of `rings` rings of 32 vertices (no caps). Every vertex is weighted to joints 0,
+ * 1 and 2, so palettes cannot tell rings apart, but the weight order changes from ring to ring:
+ * each ring has its own tuple. */
+static mesh make_tube(int rings)
+{
+    enum { AROUND = 32 };
+    mesh m;
+    m.vertex_count = (size_t)rings * AROUND;
+    m.index_count = (size_t)(rings - 1) * AROUND * 6;
+    m.positions = malloc(m.vertex_count * 3 * sizeof(float));
+    m.indices = malloc(m.index_count * sizeof(uint32_t));
+    m.joints = calloc(m.vertex_count * K, sizeof(uint16_t));
+    m.weights = calloc(m.vertex_count * K, sizeof(float));
+    for (int r = 0; r < rings; ++r)
+        for (int a = 0; a < AROUND; ++a) {
+            size_t v = (size_t)r * AROUND + a;
+            float angle = 6.2831853f * (float)a / AROUND;
+            m.positions[v * 3] = cosf(angle);
+            m.positions[v * 3 + 1] = sinf(angle);
+            m.positions[v * 3 + 2] = (float)r;
+            static const uint16_t orders[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+            static const float weights[3] = {0.5f, 0.3f, 0.2f};
+            for (int s = 0; s < 3; ++s) {
+                m.joints[v * K + s] = orders[r % 6][s];
+                m.weights[v * K + s] = weights[s];
+            }
+        }
+    size_t i = 0;
+    for (int r = 0; r + 1 < rings; ++r)
+        for (int a = 0; a < AROUND; ++a) {
+            uint32_t p = (uint32_t)(r * AROUND + a), q = (uint32_t)(r * AROUND + (a + 1) % AROUND);
+            uint32_t quad[6] = {p, q, q + AROUND, p, q + AROUND, p + AROUND};
+            memcpy(m.indices + i, quad, sizeof(quad));
+            i += 6;
+        }
+    return m;
+}
+
+/* tuple_cost keeps a meshlet's local tuple LUT small: on the tube, a meshlet that spans one band
+ * (two rings, 64 vertices) has 2 tuples and 1-bit local indices; one that wanders over three
+ * rings needs 3 tuples and 2 bits. */
+static void test_tuple_cost(void)
+{
+    mesh tube = make_tube(9);
+    sp_meshlet_options o = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_stats with_cost = build_and_check(&tube, &o, "tube");
+    o.tuple_cost = 0.0f;
+    sp_meshlet_stats without = build_and_check(&tube, &o, "tube, tuple_cost 0");
+    EXPECT(with_cost.local_tuple_bits_mean <= 1.0 && with_cost.local_tuple_bits_mean < without.local_tuple_bits_mean,
+           "local tuple bits %.2f with the default tuple_cost, %.2f without", with_cost.local_tuple_bits_mean,
+           without.local_tuple_bits_mean);
+    EXPECT(with_cost.meshlet_count <= without.meshlet_count + 1, "tuple_cost made %zu meshlets, %zu without",
+           with_cost.meshlet_count, without.meshlet_count);
+    printf("tube: local tuple bits %.2f with tuple_cost %.2f (%zu meshlets), %.2f without (%zu meshlets)\n",
+           with_cost.local_tuple_bits_mean, (double)options_for(SP_MESHLETS_SKIN, 64, 124, 32).tuple_cost,
+           with_cost.meshlet_count, without.local_tuple_bits_mean, without.meshlet_count);
+    free_mesh(&tube);
+}
+
+/* The joint lower bound (used by the meshlet benchmark to show where a target is out of reach)
+ * on strips where the optimum is known, and never above what a builder achieves. */
+static void test_joint_lower_bound(void)
+{
+    struct { int columns; size_t by_joint, forced, by_count, bound; } cases[] = {
+        {30, 2, 0, 1, 2}, /* 60 vertices: one meshlet holds both joints */
+        {40, 2, 1, 2, 3}, /* 80 vertices: two meshlets, and the middle quad needs both joints in one */
+    };
+    for (size_t c = 0; c < sizeof(cases) / sizeof(cases[0]); ++c) {
+        mesh strip = make_two_joint_strip(cases[c].columns);
+        meshlet_input in = input_of(&strip);
+        joint_bound b;
+        EXPECT(joint_bound_compute(&in, 64, 124, &b), "out of memory");
+        EXPECT(b.by_joint == cases[c].by_joint && b.forced_splits == cases[c].forced &&
+                   b.by_influence_count == cases[c].by_count && b.palette_sum == cases[c].bound,
+               "%d columns: by joint %zu, forced %zu, by count %zu, bound %zu", cases[c].columns, b.by_joint,
+               b.forced_splits, b.by_influence_count, b.palette_sum);
+        for (uint32_t builder = 0; builder < SP_MESHLETS_BUILDER_COUNT; ++builder) {
+            sp_meshlet_options o = options_for(builder, 64, 124, 32);
+            sp_meshlet_stats s = build_and_check(&strip, &o, "strip");
+            double palette_sum = s.mean_joints * (double)s.meshlet_count;
+            EXPECT(palette_sum + 0.5 >= (double)b.palette_sum, "%s: %.0f palette entries below the bound %zu",
+                   builder_name(builder), palette_sum, b.palette_sum);
+            if (builder == SP_MESHLETS_SKIN) /* the bound is reached on these strips */
+                EXPECT(palette_sum < (double)b.palette_sum + 0.5, "skin builder: %.0f palette entries, optimum %zu",
+                       palette_sum, b.palette_sum);
+        }
+        free_mesh(&strip);
+    }
+}
+
 int main(void)
 {
     test_checker_catches_corruption();
@@ -466,6 +588,8 @@ int main(void)
     test_skin_builder_quality();
     test_degenerate_triangles();
     test_palette_limit_error();
+    test_joint_lower_bound();
+    test_tuple_cost();
     test_invalid_arguments();
     if (failures) {
         fprintf(stderr, "test_meshlets_unit: %d failures\n", failures);
