@@ -102,7 +102,8 @@ typedef struct SpSkinParameters {
 #define SP_BINDING_TUPLE_LUT 2    /* uint[]: the tuple LUT bytes (u8 or u16 joints), zero-padded to 4 bytes */
 #define SP_BINDING_JOINT_MATRICES 3 /* vec4[]: 3 rows of a 3x4 affine matrix per joint, per instance */
 #define SP_BINDING_POSITIONS 4    /* float[]: 3 floats per bind-pose vertex */
-#define SP_BINDING_OUTPUT 5       /* decode.comp: SpDecodedRecord[]; skin.comp: float[] 3 per vertex */
+#define SP_BINDING_OUTPUT 5       /* decode.comp: SpDecodedRecord[]; skin.comp: float[] 3 per vertex;
+                                     skin_meshlet_test.comp: SpMeshletOutputRecord[] */
 #define SP_BINDING_BASELINE 6     /* uint[]: baseline weights and joints (SP_VERTEX_FORMAT_*) */
 #define SP_BINDING_MESHLETS 7     /* uint[]: sp_meshlet records, SP_MESHLET_WORDS words each */
 #define SP_BINDING_MESHLET_DATA 8 /* uint[]: the meshlet byte arrays, see SP_MESHLET_DATA_* below */
@@ -156,6 +157,35 @@ typedef struct SpDecodedRecord {
 #define SP_MESHLET_WORD_CENTER 7      /* 3 floats, then radius */
 #define SP_MESHLET_WORD_CONE_APEX 11  /* 3 floats */
 #define SP_MESHLET_WORD_CONE_AXIS 14  /* 3 floats, then cone_cutoff */
+
+/*
+ * What skin.mesh is declared for: sp_meshlet_options defaults (64 vertices, 124 triangles; the
+ * host builds meshlets with them and checks that they fit) and one 32-thread workgroup.
+ */
+#define SP_MESH_SHADER_MAX_VERTICES 64
+#define SP_MESH_SHADER_MAX_TRIANGLES 124
+#define SP_MESH_SHADER_GROUP_SIZE 32
+
+/*
+ * skin_meshlet_test.comp: what one skin.mesh workgroup (meshlet m, instance i) would emit,
+ * written to record i * meshlet_count + m so that lavapipe, which has no mesh shaders, can
+ * check the shared body (shaders/skin_meshlet.glsl) against C. Entries past the counts are
+ * left as the host filled them.
+ */
+#ifdef VULKAN
+struct SpMeshletOutputRecord {
+#else
+typedef struct SpMeshletOutputRecord {
+#endif
+    SP_GPU_UVEC4 counts;                                   /* vertex count, triangle count (0, 0: meshlet culled), 0, 0 */
+    SP_GPU_VEC4 clip[SP_MESH_SHADER_MAX_VERTICES];         /* gl_Position of each meshlet vertex */
+    SP_GPU_VEC4 world[SP_MESH_SHADER_MAX_VERTICES];        /* world position (xyz), 0 */
+    SP_GPU_UVEC4 triangles[SP_MESH_SHADER_MAX_TRIANGLES];  /* local corners (xyz), gl_CullPrimitiveEXT (w: 0 | 1) */
+#ifdef VULKAN
+};
+#else
+} SpMeshletOutputRecord;
+#endif
 
 /*
  * The five sp_meshlet_buffers arrays - vertices (u32), vertex_tuples (u8), triangles (u8 x 3),

@@ -245,30 +245,6 @@ static void load_mesh(vkx_context* ctx, bench_mesh* m, const char* path, vkx_buf
     free(weights4);
 }
 
-/* Perspective camera over the instance grid, Vulkan clip space (y down, depth 0..1). */
-static void camera_matrix(float aspect, const float eye[3], const float target[3], float out[16])
-{
-    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
-    float fl = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    for (int i = 0; i < 3; ++i) f[i] /= fl;
-    float up[3] = {0, 0, 1};
-    float s[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]};
-    float sl = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    for (int i = 0; i < 3; ++i) s[i] /= sl;
-    float u[3] = {s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0]};
-    float view[16] = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
-                      -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
-                      f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 1};
-    float near = 0.05f * fl, far = 4.0f * fl, t = 1.0f / tanf(0.5f * 1.0471976f);
-    float projection[16] = {t / aspect, 0, 0, 0, 0, -t, 0, 0, 0, 0, far / (near - far), -1, 0, 0, near * far / (near - far), 0};
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            float sum = 0;
-            for (int k = 0; k < 4; ++k) sum += projection[k * 4 + r] * view[c * 4 + k];
-            out[c * 4 + r] = sum;
-        }
-}
-
 /* Copies the colour attachment of the last frame into a host-visible buffer. */
 static void record_readback(VkCommandBuffer cmd, const vkx_image* color, const vkx_buffer* readback, uint32_t width,
                             uint32_t height)
@@ -365,7 +341,7 @@ int main(int argc, char** argv)
     float spacing = 1.25f * extent, size = spacing * (float)columns;
     float eye[3] = {0.5f * (size - spacing), -0.45f * size - 0.5f * spacing, 0.5f * size + 0.5f * spacing};
     float target[3] = {0.5f * (size - spacing), 0.35f * (size - spacing), 0.25f * extent};
-    camera_matrix((float)opt.width / (float)opt.height, eye, target, params.view_projection.columns);
+    sp_gpu_camera((float)opt.width / (float)opt.height, eye, target, params.view_projection.columns);
     params.camera = (sp_gpu_vec4){eye[0], eye[1], eye[2], spacing};
 
     VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM, depth_format = VK_FORMAT_D32_SFLOAT;

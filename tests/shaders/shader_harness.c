@@ -7,6 +7,8 @@
  *   skinpack_shader_harness vertices    packed vertex words + tuple LUT (u8 and u16) of random skins
  *   skinpack_shader_harness mesh FILE   a real mesh skinned in a pose (skin.comp) vs C skinning
  *   skinpack_shader_harness meshlets FILE   skin.mesh's palette / local LUT / triangle fetch
+ *   skinpack_shader_harness meshshader FILE skin.mesh's body (skin_meshlet.glsl) run as compute:
+ *                                           skinning, triangle and normal-cone culling vs C
  *
  * Per decoded code the checks are: (1) the GPU's integers re-encode to the input code with the
  * format.md formulas (exact at every width); (2) they lie on the grid (sum q_i = s, descending;
@@ -16,36 +18,26 @@
  * Exit status 1 on any mismatch or Vulkan failure.
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "harness.h"
 #include "skinpack.h"
 #include "sp_gpu.h"
 #include "vk_context.h"
 
 #define WEIGHT_TOLERANCE 1e-6f
-#define MAX_REPORTED_FAILURES 10
 
 typedef unsigned __int128 u128;
-
-typedef struct harness {
-    vkx_context ctx;
-    VkPipeline decode_pipeline;
-    vkx_buffer dummy;
-    size_t checked;
-    size_t failures;
-    size_t unsorted_codes; /* codes libskinpack accepts whose weights are not descending */
-} harness;
 
 typedef struct decode_push {
     uint32_t mode, item_count, force_wide;
     uint32_t meshlet_arrays[5]; /* meshlet mode: word offsets of the five meshlet arrays */
 } decode_push;
 
-static void fail_check(harness* h, const char* format, ...) __attribute__((format(printf, 2, 3)));
-#include <stdarg.h>
-static void fail_check(harness* h, const char* format, ...)
+void fail_check(harness* h, const char* format, ...)
 {
     if (++h->failures <= MAX_REPORTED_FAILURES) {
         va_list args;
@@ -846,8 +838,10 @@ static void test_mesh(harness* h, const char* path)
 
 int main(int argc, char** argv)
 {
-    if (argc < 2 || ((strcmp(argv[1], "mesh") == 0 || strcmp(argv[1], "meshlets") == 0) && argc < 3)) {
-        fprintf(stderr, "usage: %s codes|widths|vertices|mesh FILE|meshlets FILE\n", argv[0]);
+    int needs_file = argc >= 2 && (strcmp(argv[1], "mesh") == 0 || strcmp(argv[1], "meshlets") == 0 ||
+                                   strcmp(argv[1], "meshshader") == 0);
+    if (argc < 2 || (needs_file && argc < 3)) {
+        fprintf(stderr, "usage: %s codes|widths|vertices|mesh FILE|meshlets FILE|meshshader FILE\n", argv[0]);
         return 2;
     }
     harness h;
@@ -865,6 +859,7 @@ int main(int argc, char** argv)
     else if (strcmp(argv[1], "vertices") == 0) test_vertices(&h);
     else if (strcmp(argv[1], "mesh") == 0) test_mesh(&h, argv[2]);
     else if (strcmp(argv[1], "meshlets") == 0) test_meshlets(&h, argv[2]);
+    else if (strcmp(argv[1], "meshshader") == 0) test_meshshader(&h, argv[2]);
     else {
         fprintf(stderr, "unknown test %s\n", argv[1]);
         return 2;

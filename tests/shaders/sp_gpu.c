@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 199309L
 #include "sp_gpu.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -151,6 +152,8 @@ _Static_assert(offsetof(sp_meshlet, cone_cutoff) == (SP_MESHLET_WORD_CONE_AXIS +
 /* The push-constant block is exactly the 128 bytes every device guarantees. */
 _Static_assert(sizeof(SpSkinParameters) == 128, "SpSkinParameters must stay 128 bytes");
 _Static_assert(sizeof(SpGpuCodec) == 8 * 16, "SpGpuCodec is 8 vec4s");
+_Static_assert(sizeof(SpMeshletOutputRecord) == (1 + 2 * SP_MESH_SHADER_MAX_VERTICES + SP_MESH_SHADER_MAX_TRIANGLES) * 16,
+               "SpMeshletOutputRecord is vec4s only, no padding");
 
 sp_result sp_gpu_meshlets_build(const uint32_t* indices, size_t index_count, const float* positions,
                                 size_t vertex_count, size_t position_stride, const uint16_t* joints,
@@ -199,4 +202,27 @@ void sp_gpu_meshlets_free(sp_gpu_meshlets* meshlets)
     free(a->tuples);
     free(meshlets->data);
     memset(meshlets, 0, sizeof(*meshlets));
+}
+
+void sp_gpu_camera(float aspect, const float eye[3], const float target[3], float out[16])
+{
+    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
+    float fl = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    for (int i = 0; i < 3; ++i) f[i] /= fl;
+    float up[3] = {0, 0, 1};
+    float s[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]};
+    float sl = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int i = 0; i < 3; ++i) s[i] /= sl;
+    float u[3] = {s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0]};
+    float view[16] = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
+                      -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
+                      f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 1};
+    float near = 0.05f * fl, far = 4.0f * fl, t = 1.0f / tanf(0.5f * 1.0471976f);
+    float projection[16] = {t / aspect, 0, 0, 0, 0, -t, 0, 0, 0, 0, far / (near - far), -1, 0, 0, near * far / (near - far), 0};
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            float sum = 0;
+            for (int k = 0; k < 4; ++k) sum += projection[k * 4 + r] * view[c * 4 + k];
+            out[c * 4 + r] = sum;
+        }
 }

@@ -46,6 +46,11 @@ void sp_skin_mesh_free(sp_skin_mesh* mesh);
 void sp_reference_skin(const float* positions, size_t vertex_count, const uint16_t* joints, const float* weights,
                        size_t influences, const float* matrix_rows, float* out);
 
+/* Column-major view-projection of a perspective camera at eye looking at target, z up, 60 degree
+ * vertical field of view, near/far at 0.05/4 x the distance; Vulkan clip space (y down, depth
+ * 0..1). Shared by the benchmark and the mesh-shader test so both see the same camera. */
+void sp_gpu_camera(float aspect, const float eye[3], const float target[3], float out[16]);
+
 /* Meshlets of a skin at the default limits (skin.mesh's 64 vertices / 124 triangles), with the
  * library's arrays and the same arrays packed into one word buffer as skinpack_gpu_layout.h
  * describes (offsets[a] = word offset of vertices, vertex_tuples, triangles, joints, tuples). */

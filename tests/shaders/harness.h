@@ -1,0 +1,29 @@
+/*
+ * harness.h - what the parts of skinpack_shader_harness share: the Vulkan context, the mismatch
+ * counter, and the tests that live in files of their own.
+ */
+#ifndef SKINPACK_HARNESS_H
+#define SKINPACK_HARNESS_H
+
+#include <stddef.h>
+
+#include "vk_context.h"
+
+#define MAX_REPORTED_FAILURES 10
+
+typedef struct harness {
+    vkx_context ctx;
+    VkPipeline decode_pipeline;
+    vkx_buffer dummy;
+    size_t checked;
+    size_t failures;
+    size_t unsorted_codes; /* codes libskinpack accepts whose weights are not descending */
+} harness;
+
+/* Counts a mismatch; prints the first MAX_REPORTED_FAILURES. */
+void fail_check(harness* h, const char* format, ...) __attribute__((format(printf, 2, 3)));
+
+/* meshshader FILE (harness_meshshader.c): skin.mesh's body through skin_meshlet_test.comp. */
+void test_meshshader(harness* h, const char* path);
+
+#endif
