@@ -263,7 +263,9 @@ VkDescriptorSet vkx_descriptor_set(vkx_context* ctx, vkx_buffer* const buffers[S
 VkShaderModule vkx_shader(vkx_context* ctx, const char* file_name)
 {
     char path[1024];
-    snprintf(path, sizeof(path), "%s/%s", SKINPACK_SHADER_DIR, file_name);
+    /* SKINPACK_SHADER_DIR in the environment: a staged copy run elsewhere (tests/bench/gpu_stage.sh) */
+    const char* folder = getenv("SKINPACK_SHADER_DIR") ? getenv("SKINPACK_SHADER_DIR") : SKINPACK_SHADER_DIR;
+    snprintf(path, sizeof(path), "%s/%s", folder, file_name);
     FILE* file = fopen(path, "rb");
     if (!file) vkx_fail("cannot open %s (build the skinpack_shaders target)", path);
     fseek(file, 0, SEEK_END);
