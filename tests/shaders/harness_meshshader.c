@@ -133,17 +133,7 @@ static SpMeshletOutputRecord* gpu_meshlet_outputs(harness* h, VkPipeline pipelin
     memcpy(bindings, inputs, sizeof(bindings));
     bindings[SP_BINDING_OUTPUT] = &output;
     VkDescriptorSet set = vkx_descriptor_set(ctx, bindings, &h->dummy);
-    VkCommandBuffer cmd = vkx_begin(ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, sizeof(*params), params);
-    vkCmdDispatch(cmd, meshlet_count, instances, 1);
-    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
-                         0, NULL);
-    vkx_submit_and_wait(ctx, cmd);
+    vkx_dispatch_and_wait(ctx, pipeline, set, params, (uint32_t)sizeof(*params), meshlet_count, instances);
     SpMeshletOutputRecord* records = malloc(record_count * sizeof(SpMeshletOutputRecord));
     memcpy(records, output.mapped, record_count * sizeof(SpMeshletOutputRecord));
     vkResetDescriptorPool(ctx->device, ctx->descriptor_pool, 0);
@@ -383,27 +373,13 @@ static instance_reference* reference_instances(const sp_skin_mesh* mesh, const u
 static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
 {
     size_t n = mesh->vertex_count;
-    uint32_t* words = malloc(n * 2 * sizeof(uint32_t));
-    uint16_t* lut = malloc(n * 4 * sizeof(uint16_t));
-    uint8_t* lut_bytes = malloc(n * 4 * sizeof(uint16_t));
-    uint16_t* joints = malloc(n * 4 * sizeof(uint16_t));
-    float* weights = malloc(n * 4 * sizeof(float));
-    size_t scratch_size = sp_compress_scratch_bound(n, 8);
-    void* scratch = malloc(scratch_size);
-    sp_compress_options options;
-    sp_compress_options_default(&options); /* OSS, K = 4, 32-bit words */
-    sp_compressed_skin skin;
-    if (sp_compress_skin(mesh->joints, mesh->weights, n, 8, mesh->joint_count, &options, words, lut, NULL, NULL, &skin, scratch,
-                         scratch_size) != SP_OK ||
-        sp_decompress_skin(&skin.codec, words, n, skin.tuple_bits, lut, skin.lut_size, mesh->joint_count, joints, weights,
-                           NULL) != SP_OK)
-        vkx_fail("%s: compress/decompress failed", mesh->name);
+    sp_gpu_default_skin packed;
+    sp_gpu_default_skin_build(mesh, &packed);
+    const sp_compressed_skin skin = packed.skin;
+    const uint16_t* joints = packed.joints;
+    const float* weights = packed.weights;
     uint32_t k = skin.influences;
     size_t lut_entries = skin.lut_size * k;
-    for (size_t e = 0; e < lut_entries; ++e) {
-        lut_bytes[skin.joint_bytes * e] = (uint8_t)lut[e];
-        if (skin.joint_bytes == 2) lut_bytes[2 * e + 1] = (uint8_t)(lut[e] >> 8);
-    }
 
     sp_gpu_meshlets built;
     sp_result result = sp_gpu_meshlets_build(mesh->indices, (size_t)mesh->triangle_count * 3, mesh->positions, n, 12,
@@ -439,8 +415,8 @@ static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
     vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
     memcpy(codec_buffer.mapped, &gpu_codec, sizeof(gpu_codec));
     VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    vkx_buffer words_buffer = vkx_upload(ctx, words, n * skin.words_per_vertex * 4, storage);
-    vkx_buffer lut_buffer = vkx_upload(ctx, lut_bytes, lut_entries * skin.joint_bytes, storage);
+    vkx_buffer words_buffer = vkx_upload(ctx, packed.words, n * skin.words_per_vertex * 4, storage);
+    vkx_buffer lut_buffer = vkx_upload(ctx, packed.lut_bytes, lut_entries * skin.joint_bytes, storage);
     vkx_buffer matrix_buffer = vkx_upload(ctx, matrices, (size_t)MESHSHADER_INSTANCES * mesh->joint_count * 12 * sizeof(float), storage);
     vkx_buffer position_buffer = vkx_upload(ctx, mesh->positions, n * 3 * sizeof(float), storage);
     vkx_buffer meshlet_buffer = vkx_upload(ctx, built.arrays.meshlets, stats->meshlet_count * sizeof(sp_meshlet), storage);
@@ -486,12 +462,7 @@ static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
     free(refs);
     free(matrices);
     sp_gpu_meshlets_free(&built);
-    free(words);
-    free(lut);
-    free(lut_bytes);
-    free(joints);
-    free(weights);
-    free(scratch);
+    sp_gpu_default_skin_free(&packed);
     return counts;
 }
 

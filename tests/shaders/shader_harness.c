@@ -72,17 +72,7 @@ static SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t
     VkDescriptorSet set = vkx_descriptor_set(ctx, bindings, &h->dummy);
 
     decode_push push = {mode, (uint32_t)item_count, (uint32_t)force_wide, {0}};
-    VkCommandBuffer cmd = vkx_begin(ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, h->decode_pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
-    vkCmdDispatch(cmd, (uint32_t)((item_count + 63) / 64), 1, 1);
-    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
-                         0, NULL);
-    vkx_submit_and_wait(ctx, cmd);
+    vkx_dispatch_and_wait(ctx, h->decode_pipeline, set, &push, (uint32_t)sizeof(push), (uint32_t)((item_count + 63) / 64), 1);
 
     SpDecodedRecord* records = malloc(item_count * sizeof(SpDecodedRecord));
     memcpy(records, output.mapped, item_count * sizeof(SpDecodedRecord));
@@ -508,20 +498,11 @@ static void test_meshlets(harness* h, const char* path)
     sp_skin_mesh mesh;
     sp_skin_mesh_load(path, &mesh);
     size_t n = mesh.vertex_count;
-    uint32_t* words = malloc(n * 2 * sizeof(uint32_t));
-    uint16_t* lut = malloc(n * 4 * sizeof(uint16_t));
-    uint16_t* joints = malloc(n * 4 * sizeof(uint16_t));
-    float* weights = malloc(n * 4 * sizeof(float));
-    size_t scratch_size = sp_compress_scratch_bound(n, 8);
-    void* scratch = malloc(scratch_size);
-    sp_compress_options options;
-    sp_compress_options_default(&options); /* OSS, K = 4, 32-bit words */
-    sp_compressed_skin skin;
-    if (sp_compress_skin(mesh.joints, mesh.weights, n, 8, mesh.joint_count, &options, words, lut, NULL, NULL, &skin, scratch,
-                         scratch_size) != SP_OK ||
-        sp_decompress_skin(&skin.codec, words, n, skin.tuple_bits, lut, skin.lut_size, mesh.joint_count, joints, weights,
-                           NULL) != SP_OK)
-        vkx_fail("%s: compress/decompress failed", path);
+    sp_gpu_default_skin packed;
+    sp_gpu_default_skin_build(&mesh, &packed);
+    const sp_compressed_skin skin = packed.skin;
+    const uint16_t* joints = packed.joints;
+    const float* weights = packed.weights;
     uint32_t k = skin.influences;
 
     sp_gpu_meshlets built;
@@ -544,7 +525,7 @@ static void test_meshlets(harness* h, const char* path)
                                              (uint32_t)skin.lut_size, mesh.joint_count);
     vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
     memcpy(codec_buffer.mapped, &gpu_codec, sizeof(gpu_codec));
-    vkx_buffer words_buffer = vkx_upload(ctx, words, n * skin.words_per_vertex * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vkx_buffer words_buffer = vkx_upload(ctx, packed.words, n * skin.words_per_vertex * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer meshlet_buffer = vkx_upload(ctx, out.meshlets, stats.meshlet_count * sizeof(sp_meshlet), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer data_buffer = vkx_upload(ctx, data, total_words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer records_buffer = vkx_buffer_create(ctx, stats.vertex_count * sizeof(SpDecodedRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
@@ -559,17 +540,7 @@ static void test_meshlets(harness* h, const char* path)
     bindings[SP_BINDING_OUTPUT] = &records_buffer;
     bindings[SP_BINDING_POSITIONS] = &corners_buffer;
     VkDescriptorSet set = vkx_descriptor_set(ctx, bindings, &h->dummy);
-    VkCommandBuffer cmd = vkx_begin(ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, h->decode_pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
-    vkCmdDispatch(cmd, (uint32_t)stats.meshlet_count, 1, 1);
-    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
-                         0, NULL);
-    vkx_submit_and_wait(ctx, cmd);
+    vkx_dispatch_and_wait(ctx, h->decode_pipeline, set, &push, (uint32_t)sizeof(push), (uint32_t)stats.meshlet_count, 1);
 
     const SpDecodedRecord* records = records_buffer.mapped;
     const uint32_t* corners = corners_buffer.mapped;
@@ -607,11 +578,7 @@ static void test_meshlets(harness* h, const char* path)
     vkx_buffer* all[] = {&codec_buffer, &words_buffer, &meshlet_buffer, &data_buffer, &records_buffer, &corners_buffer};
     for (size_t i = 0; i < sizeof(all) / sizeof(all[0]); ++i) vkx_buffer_destroy(ctx, all[i]);
     sp_gpu_meshlets_free(&built);
-    free(words);
-    free(lut);
-    free(joints);
-    free(weights);
-    free(scratch);
+    sp_gpu_default_skin_free(&packed);
     sp_skin_mesh_free(&mesh);
 }
 
@@ -647,17 +614,7 @@ static float* gpu_skin(harness* h, VkPipeline pipeline, const sp_skin_mesh* mesh
     SpSkinParameters push;
     memset(&push, 0, sizeof(push));
     push.counts = (sp_gpu_uvec4){mesh->vertex_count, mesh->joint_count, 1, 0};
-    VkCommandBuffer cmd = vkx_begin(ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
-    vkCmdDispatch(cmd, (mesh->vertex_count + 63) / 64, 1, 1);
-    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
-                         0, NULL);
-    vkx_submit_and_wait(ctx, cmd);
+    vkx_dispatch_and_wait(ctx, pipeline, set, &push, (uint32_t)sizeof(push), (uint32_t)((mesh->vertex_count + 63) / 64), 1);
     float* result = malloc((size_t)mesh->vertex_count * 3 * sizeof(float));
     memcpy(result, output.mapped, (size_t)mesh->vertex_count * 3 * sizeof(float));
     vkResetDescriptorPool(ctx->device, ctx->descriptor_pool, 0);

@@ -226,3 +226,37 @@ void sp_gpu_camera(float aspect, const float eye[3], const float target[3], floa
             out[c * 4 + r] = sum;
         }
 }
+
+void sp_gpu_default_skin_build(const sp_skin_mesh* mesh, sp_gpu_default_skin* out)
+{
+    size_t n = mesh->vertex_count;
+    out->words = malloc(n * 2 * sizeof(uint32_t));
+    out->lut = malloc(n * 4 * sizeof(uint16_t));
+    out->lut_bytes = malloc(n * 4 * sizeof(uint16_t));
+    out->joints = malloc(n * 4 * sizeof(uint16_t));
+    out->weights = malloc(n * 4 * sizeof(float));
+    size_t scratch_size = sp_compress_scratch_bound(n, 8);
+    void* scratch = malloc(scratch_size);
+    sp_compress_options options;
+    sp_compress_options_default(&options);
+    sp_compressed_skin* skin = &out->skin;
+    if (sp_compress_skin(mesh->joints, mesh->weights, n, 8, mesh->joint_count, &options, out->words, out->lut, NULL, NULL,
+                         skin, scratch, scratch_size) != SP_OK ||
+        sp_decompress_skin(&skin->codec, out->words, n, skin->tuple_bits, out->lut, skin->lut_size, mesh->joint_count,
+                           out->joints, out->weights, NULL) != SP_OK)
+        vkx_fail("%s: compress/decompress failed", mesh->name);
+    free(scratch);
+    for (size_t e = 0; e < skin->lut_size * skin->influences; ++e) {
+        out->lut_bytes[skin->joint_bytes * e] = (uint8_t)out->lut[e];
+        if (skin->joint_bytes == 2) out->lut_bytes[2 * e + 1] = (uint8_t)(out->lut[e] >> 8);
+    }
+}
+
+void sp_gpu_default_skin_free(sp_gpu_default_skin* packed)
+{
+    free(packed->words);
+    free(packed->lut);
+    free(packed->lut_bytes);
+    free(packed->joints);
+    free(packed->weights);
+}

@@ -46,6 +46,21 @@ void sp_skin_mesh_free(sp_skin_mesh* mesh);
 void sp_reference_skin(const float* positions, size_t vertex_count, const uint16_t* joints, const float* weights,
                        size_t influences, const float* matrix_rows, float* out);
 
+/* A mesh's skin compressed with the default options (OSS, K = 4, one 32-bit word a vertex), its
+ * tuple LUT as the shaders read it, and what the C decoder makes of it, to compare against. */
+typedef struct sp_gpu_default_skin {
+    sp_compressed_skin skin;
+    uint32_t* words;    /* skin.words_per_vertex per vertex */
+    uint16_t* lut;      /* skin.lut_size x K joints */
+    uint8_t* lut_bytes; /* the same, skin.joint_bytes each, little-endian */
+    uint16_t* joints;   /* decoded: K per vertex */
+    float* weights;
+} sp_gpu_default_skin;
+
+/* Compresses and decodes mesh's skin; exits with a FAIL message when the library refuses. */
+void sp_gpu_default_skin_build(const sp_skin_mesh* mesh, sp_gpu_default_skin* out);
+void sp_gpu_default_skin_free(sp_gpu_default_skin* packed);
+
 /* Column-major view-projection of a perspective camera at eye looking at target, z up, 60 degree
  * vertical field of view, near/far at 0.05/4 x the distance; Vulkan clip space (y down, depth
  * 0..1). Shared by the benchmark and the mesh-shader test so both see the same camera. */

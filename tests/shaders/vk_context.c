@@ -429,6 +429,22 @@ void vkx_submit_and_wait(vkx_context* ctx, VkCommandBuffer cmd)
     vkFreeCommandBuffers(ctx->device, ctx->command_pool, 1, &cmd);
 }
 
+void vkx_dispatch_and_wait(vkx_context* ctx, VkPipeline pipeline, VkDescriptorSet set, const void* push,
+                           uint32_t push_size, uint32_t groups_x, uint32_t groups_y)
+{
+    VkCommandBuffer cmd = vkx_begin(ctx);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
+    vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, push_size, push);
+    vkCmdDispatch(cmd, groups_x, groups_y, 1);
+    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
+                         0, NULL);
+    vkx_submit_and_wait(ctx, cmd);
+}
+
 vkx_image vkx_image_create(vkx_context* ctx, uint32_t width, uint32_t height, VkFormat format, VkImageUsageFlags usage,
                            VkImageAspectFlags aspect)
 {

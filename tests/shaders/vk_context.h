@@ -85,6 +85,11 @@ VkCommandBuffer vkx_begin(vkx_context* ctx);
 /* Ends, submits, waits for idle and frees the command buffer. */
 void vkx_submit_and_wait(vkx_context* ctx, VkCommandBuffer cmd);
 
+/* One compute dispatch of groups_x x groups_y workgroups with the set and push constants, made
+ * visible to the host before it returns (the tests read the output buffers right after). */
+void vkx_dispatch_and_wait(vkx_context* ctx, VkPipeline pipeline, VkDescriptorSet set, const void* push,
+                           uint32_t push_size, uint32_t groups_x, uint32_t groups_y);
+
 /* A device-local 2D image with its view (colour or depth attachment). */
 typedef struct vkx_image {
     VkImage image;
