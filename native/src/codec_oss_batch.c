@@ -440,14 +440,15 @@ static sp_oss_isa batch_isa(sp_oss_isa widest)
 }
 
 /* AVX-512 takes blocks of 8, AVX2 what is left in blocks of 4 (the tail, or the rest after a
- * block the AVX-512 loop stopped at), the scalar loop in codec.c the remainder. */
+ * block the AVX-512 loop stopped at), the scalar loop in codec.c the remainder. Nothing left:
+ * no AVX2 call, whose pointer arithmetic on the null arrays of an empty batch is undefined. */
 size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                            uint8_t* significant, sp_oss_isa widest)
 {
     sp_oss_isa isa = batch_supported(codec) ? batch_isa(widest) : SP_OSS_ISA_SCALAR;
     size_t done = 0;
     if (isa >= SP_OSS_ISA_AVX512) done = sp_oss_encode_avx512(codec, weights, count, codes, significant);
-    if (isa >= SP_OSS_ISA_AVX2)
+    if (isa >= SP_OSS_ISA_AVX2 && done < count)
         done += encode_avx2(codec, weights + done * codec->influences, count - done, codes + done,
                             significant ? significant + done : NULL);
     return done;
@@ -459,7 +460,7 @@ size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t 
     sp_oss_isa isa = batch_supported(codec) ? batch_isa(widest) : SP_OSS_ISA_SCALAR;
     size_t done = 0;
     if (isa >= SP_OSS_ISA_AVX512) done = sp_oss_decode_avx512(codec, codes, count, weights);
-    if (isa >= SP_OSS_ISA_AVX2)
+    if (isa >= SP_OSS_ISA_AVX2 && done < count)
         done += decode_avx2(codec, codes + done, count - done, weights + done * codec->influences);
     return done;
 }

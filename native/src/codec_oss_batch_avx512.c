@@ -3,11 +3,13 @@
  * eight double lanes, compare masks in mask registers, and the AoS weights moved in and out
  * with two-source permutes instead of per-lane inserts and extracts.
  *
- * Same arithmetic, same operation order as the AVX2 path (and so as the scalar code) for every
+ * Same rounding steps in the same order as the AVX2 path (and so as the scalar code) for every
  * value that reaches the output, the same exactness argument (integers below 2^50 in double
  * lanes) and the same rule: a lane the vector code cannot prove exact is redone by the scalar
- * code. See codec_oss_batch.c. Only decode's layer and row *estimates* differ (rcp14/rsqrt14
- * with explicit FMAs, a shifted row estimate): the exact integer checks decide every lane.
+ * code. See codec_oss_batch.c. The OSS index arithmetic may take other forms (Horner, explicit
+ * FMAs): its every intermediate is an integer or a quarter below 2^50, exact in any order. And
+ * decode's layer and row *estimates* differ (rcp14, shifted arguments, no layer square root):
+ * the exact integer checks decide every lane.
  */
 #include "codec_internal.h"
 
@@ -16,7 +18,8 @@
 
 /* avx512f implies fma, and both compilers then fuse some multiplies and adds (GCC's gnu11
  * default contracts across statements), which round differently from the scalar code: keep
- * every product and sum rounded on its own. */
+ * every product and sum rounded on its own. Explicit FMA intrinsics appear only where the
+ * result is exact or an estimate. */
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT OFF
 #else
@@ -40,28 +43,24 @@ static inline SP_AVX512 __m512d floor8(__m512d x)
     return _mm512_roundscale_pd(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 }
 
-/* floor(a / d) for integral 0 <= a < 2^50 and small d, exact (see floor_div in the AVX2 path). */
-static inline SP_AVX512 __m512d floor_div8(__m512d a, double d)
+/* s_B(j) = floor(((4B + 2 - 3j) j + 1) / 4) for rows inside the triangle (positive), as
+ * floor((B + 1/2 - 3j/4) j + 1/4): every exact intermediate is a multiple of 1/4 below 2^50, so
+ * each step, fused or not, is exact. */
+static inline SP_AVX512 __m512d row_base8(__m512d b, __m512d j)
 {
-    return floor8(_mm512_mul_pd(_mm512_add_pd(a, splat(0.5)), splat(1.0 / d)));
+    __m512d quarter = _mm512_fnmadd_pd(j, splat(0.75), _mm512_add_pd(b, splat(0.5))); /* (4B + 2 - 3j) / 4 */
+    return floor8(_mm512_fmadd_pd(quarter, j, splat(0.25)));
 }
 
-/* s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4), for rows inside the triangle (positive). */
-static inline SP_AVX512 __m512d row_base8(__m512d n, __m512d j)
+/* u(k) = floor((3Nk(N - 2k + 3) + k((4k - 9)k + 6) + 2) / 9), for k <= (N + 1)/2, with the
+ * numerator a in Horner form ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2: integers below 2^50, so
+ * exact, and the last step adds 1/2 as well for floor((a + 1/2) / 9) (exact: see floor_div in
+ * the AVX2 path). */
+static inline SP_AVX512 __m512d layer_base8(double n, __m512d k)
 {
-    __m512d t = _mm512_sub_pd(_mm512_add_pd(_mm512_mul_pd(n, splat(4.0)), splat(2.0)), _mm512_mul_pd(j, splat(3.0)));
-    __m512d num = _mm512_add_pd(_mm512_mul_pd(t, j), splat(1.0));
-    return floor8(_mm512_mul_pd(num, splat(0.25)));
-}
-
-/* u(k) = floor((3Nk(N - 2k + 3) + k((4k - 9)k + 6) + 2) / 9), for k <= (N + 1)/2. */
-static inline SP_AVX512 __m512d layer_base8(__m512d n, __m512d k)
-{
-    __m512d width = _mm512_add_pd(_mm512_sub_pd(n, _mm512_add_pd(k, k)), splat(3.0));
-    __m512d a = _mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(n, splat(3.0)), k), width);
-    __m512d inner = _mm512_add_pd(_mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(k, splat(4.0)), splat(9.0)), k), splat(6.0));
-    __m512d num = _mm512_add_pd(_mm512_add_pd(a, _mm512_mul_pd(k, inner)), splat(2.0));
-    return floor_div8(num, 9.0);
+    __m512d a = _mm512_fmadd_pd(k, splat(4.0), splat(-(6 * n + 9)));
+    __m512d b = _mm512_fmadd_pd(a, k, splat(3 * n * n + 9 * n + 6));
+    return floor8(_mm512_mul_pd(_mm512_fmadd_pd(b, k, splat(2.5)), splat(1.0 / 9.0)));
 }
 
 /* ---- AoS <-> SoA ------------------------------------------------------------------------ */
@@ -160,12 +159,11 @@ static inline SP_AVX512 __mmask8 quantize_block8(const __m512d* w, uint32_t k, d
 /* sp_oss_pack on sorted lanes (the caller masks unsorted ones: the scalar wraps around there). */
 static inline SP_AVX512 __m512d pack_block8(const __m512d* q, uint32_t k, double n)
 {
-    __m512d nn = splat(n);
     if (k == 2) return q[1];
-    if (k == 3) return _mm512_add_pd(row_base8(nn, q[2]), _mm512_sub_pd(q[1], q[2]));
-    __m512d layer = q[3], bottom = _mm512_sub_pd(nn, _mm512_add_pd(layer, layer));
+    if (k == 3) return _mm512_add_pd(row_base8(splat(n), q[2]), _mm512_sub_pd(q[1], q[2]));
+    __m512d layer = q[3], bottom = _mm512_fnmadd_pd(layer, splat(2.0), splat(n));
     __m512d row = row_base8(bottom, _mm512_sub_pd(q[2], q[3]));
-    return _mm512_add_pd(_mm512_add_pd(layer_base8(nn, layer), row), _mm512_sub_pd(q[1], q[2]));
+    return _mm512_add_pd(_mm512_add_pd(layer_base8(n, layer), row), _mm512_sub_pd(q[1], q[2]));
 }
 
 /* Significant counts of eight sorted lanes: 1 + the non-zero components after the first. */
@@ -239,76 +237,70 @@ static inline SP_AVX512 __m512d clamp_floor8(__m512d e, __m512d top)
     return _mm512_min_pd(_mm512_max_pd(floor8(e), _mm512_setzero_pd()), top);
 }
 
-/* c + 1/c for c = cbrt(x), x >= 1, to ~1e-11 relative: the float exponent/3 bit trick and a
- * Halley step in float (~1e-7), then one Newton step in double whose 1/(3y^2) comes from
- * rcp14 (its 2^-14 error only scales the already tiny correction), and 1/c from rcp14 with
- * one Newton refinement (~2^-28). An estimate only: the exact integer checks catch any miss,
- * so these steps may use rcp14 and explicit FMAs freely; no zmm division or square root
- * (those were the bottleneck of the previous double Halley step). */
-static inline SP_AVX512 __m512d cube_root_plus_inverse8(__m512d x)
+/* cbrt(x) for x >= 1 to ~1e-8 relative: the float exponent/3 bit trick (3.2%), a Halley step in
+ * float with rcp14 for its division (~1e-4), then one Newton step in double whose 1/(3y^2)
+ * comes from rcp14 (its 2^-14 error only scales the already small correction). An estimate
+ * only: no division or zmm square root (those were the bottleneck of an earlier double Halley
+ * step; the float division, too, cost more than its precision is worth here). */
+static inline SP_AVX512 __m512d cube_root8(__m512d x)
 {
     __m256 xf = _mm512_cvtpd_ps(x);
     __m256i third = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_castps_si256(xf)), splatf(1.0f / 3.0f)));
     __m256 yf = _mm256_castsi256_ps(_mm256_add_epi32(third, _mm256_set1_epi32(709958130)));
     __m256 yf3 = _mm256_mul_ps(_mm256_mul_ps(yf, yf), yf);
-    yf = _mm256_div_ps(_mm256_mul_ps(yf, _mm256_add_ps(yf3, _mm256_add_ps(xf, xf))), _mm256_add_ps(_mm256_add_ps(yf3, yf3), xf));
+    __m256 inverse = _mm256_rcp14_ps(_mm256_add_ps(_mm256_add_ps(yf3, yf3), xf));
+    yf = _mm256_mul_ps(_mm256_mul_ps(yf, _mm256_add_ps(yf3, _mm256_add_ps(xf, xf))), inverse); /* y (y^3 + 2x) / (2y^3 + x) */
     __m512d y = _mm512_cvtps_pd(yf);
     __m512d y2 = _mm512_mul_pd(y, y);
     __m512d r = _mm512_rcp14_pd(_mm512_mul_pd(y2, splat(3.0)));
-    __m512d c = _mm512_fnmadd_pd(_mm512_fmsub_pd(y2, y, x), r, y); /* y - (y^3 - x) / (3y^2) */
-    __m512d ic = _mm512_rcp14_pd(c);
-    ic = _mm512_mul_pd(ic, _mm512_fnmadd_pd(c, ic, splat(2.0)));
-    return _mm512_add_pd(c, ic);
+    return _mm512_fnmadd_pd(_mm512_fmsub_pd(y2, y, x), r, y); /* y - (y^3 - x) / (3y^2) */
 }
 
-/* sqrt(x) for x > 0 to ~2^-28 relative (rsqrt14 and one refinement); NaN for x <= 0 or
- * x = inf. Only for estimates the exact checks verify. */
-static inline SP_AVX512 __m512d sqrt_estimate8(__m512d x)
-{
-    __m512d r = _mm512_rsqrt14_pd(x);
-    __m512d s = _mm512_mul_pd(x, r);
-    return _mm512_fmadd_pd(_mm512_mul_pd(r, splat(0.5)), _mm512_fnmadd_pd(s, s, x), s); /* s + (x - s^2) / (2 sqrt x) */
-}
-
-/* oss_find_row's mirrored square root estimate for w + 7/8 instead of w, floored and clamped
- * to the triangle's rows. s(j) = floor(s~(j)) with s~(j) - s(j) in {0, 1/4, 1/2, 3/4}, so
- * w = s(j) lies up to 3/4 below the smooth s~(j) and the unshifted estimate floors to j - 1
- * there (the ~0.2% of lanes the scalar code used to redo); w + 7/8 lies strictly between
- * s~(j) and s~(j + 1) for every w of row j, so in exact arithmetic the estimate is the row.
- * 12 (w + 7/8) = 12 w + 10.5: mirrored = apex^2 + 3 - 10.5 - 12 w. The exact check still
- * decides; the correctly rounded sqrt keeps the rounding error far below the 1/8 margin (an
- * rsqrt14 estimate measured slower and missed more for large N). */
-static inline SP_AVX512 __m512d row_estimate8(__m512d bottom, __m512d w)
-{
-    __m512d apex = _mm512_add_pd(_mm512_add_pd(bottom, bottom), splat(1.0));
-    __m512d mirrored = _mm512_sub_pd(_mm512_sub_pd(_mm512_mul_pd(apex, apex), splat(7.5)), _mm512_mul_pd(w, splat(12.0)));
-    __m512d estimate = _mm512_mul_pd(_mm512_sub_pd(apex, _mm512_sqrt_pd(mirrored)), splat(1.0 / 3.0));
-    __m512d last = _mm512_sub_pd(floor_div8(apex, 3.0), splat(1.0)); /* rows - 1 */
-    return clamp_floor8(estimate, last);
-}
-
-/* s(j), clearing the lanes of *ok where s(j) <= w < s(j + 1) fails (j not the exact row).
- * Row j < rows holds floor((2N - 3j) / 2) codes, so s(j + 1) is that much past s(j). */
-static inline SP_AVX512 __m512d row_check8(__m512d bottom, __m512d j, __m512d w, __mmask8* ok)
-{
-    __m512d lo = row_base8(bottom, j);
-    __m512d length = _mm512_sub_pd(_mm512_add_pd(bottom, bottom), _mm512_mul_pd(j, splat(3.0)));
-    __m512d hi = _mm512_add_pd(lo, floor8(_mm512_mul_pd(length, splat(0.5))));
-    *ok &= _mm512_cmp_pd_mask(lo, w, _CMP_LE_OQ) & _mm512_cmp_pd_mask(w, hi, _CMP_LT_OQ);
-    return lo;
-}
-
-/* oss_find_layer's estimate (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2)))
- * (the root 0 for V <= 2), floored and clamped to the layers. The scalar clamps c >= 1 first;
- * c + 1/c is the same for c and 1/c. */
+/* oss_find_layer's estimate (2N + 3 - t) / 4 with t = c + 1/c, c = cbrt(V - 1 + sqrt(V (V - 2))),
+ * for code + 17/18 instead of code, floored and clamped to the layers. V = 72 (u~(k0) - code)
+ * with k0 = (N + 1)/2 and u~ the unfloored u (u~(k) - u(k) in [0, 8/9]), which increases up to
+ * k0, so every code of layer k plus 17/18 lies strictly between u~(k) and u~(k + 1) (the same
+ * shift as the row estimate's 7/8) and in exact arithmetic the estimate is the layer; it also
+ * keeps V >= 4 for valid codes. c^3 + 1/c^3 = 2(V - 1) = b, so t is the root t >= 2 of
+ * t^3 - 3t = b, and cbrt(b) + 1/cbrt(b) is within c^-5/3 of it (below 1e-6 but for the last
+ * few codes, where b < 2000), which skips oss_find_layer's square root; 1/c comes from rcp14.
+ * b is an integer below 2^49, so the fused product is exact. */
 static inline SP_AVX512 __m512d layer_estimate8(double n, __m512d code)
 {
     double m = n + 1;
-    __m512d v = _mm512_sub_pd(splat(4 * m * m * m + 6 * m * m + 16), _mm512_mul_pd(code, splat(72.0)));
-    __m512d root = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(v, splat(2.0), _CMP_GT_OQ), sqrt_estimate8(_mm512_mul_pd(v, _mm512_sub_pd(v, splat(2.0)))));
-    __m512d c = cube_root_plus_inverse8(_mm512_add_pd(_mm512_sub_pd(v, splat(1.0)), root));
-    __m512d estimate = _mm512_mul_pd(_mm512_sub_pd(splat(2 * n + 3), c), splat(0.25));
+    __m512d b = _mm512_fnmadd_pd(code, splat(144.0), splat(8 * m * m * m + 12 * m * m - 106)); /* 2(V - 1) */
+    __m512d c = cube_root8(b);
+    __m512d estimate = _mm512_fnmadd_pd(_mm512_add_pd(c, _mm512_rcp14_pd(c)), splat(0.25), splat((2 * n + 3) / 4));
     return clamp_floor8(estimate, splat((double)(((uint64_t)n + 1) / 2 - 1)));
+}
+
+/* oss_find_row's mirrored square root estimate for w + 7/8 instead of w in the triangle with
+ * B = `bottom` samples along its bottom edge, floored and clamped to j >= 0. s(j) = floor(s~(j))
+ * with s~(j) - s(j) in {0, 1/4, 1/2, 3/4}, so w = s(j) lies up to 3/4 below the smooth s~(j)
+ * and the unshifted estimate floors to j - 1 there (the ~0.2% of lanes the scalar code used to
+ * redo); w + 7/8 lies strictly between s~(j) and s~(j + 1) for every w of row j, so in exact
+ * arithmetic the estimate is the row. With apex = 2B + 1, 12 (w + 7/8) = 12 w + 10.5:
+ * mirrored = apex^2 + 3 - 10.5 - 12 w. The exact check still decides; the correctly rounded
+ * sqrt keeps the rounding error far below the 1/8 margin (an rsqrt14 estimate measured slower
+ * and missed more for large N). No clamp to the last row: the estimate is at most
+ * apex / 3 < rows + 1, and row_offset8 rejects j = rows (a row of no codes). */
+static inline SP_AVX512 __m512d row_estimate8(__m512d bottom, __m512d w)
+{
+    __m512d apex = _mm512_fmadd_pd(bottom, splat(2.0), splat(1.0));
+    __m512d mirrored = _mm512_fnmadd_pd(w, splat(12.0), _mm512_fmsub_pd(apex, apex, splat(7.5)));
+    __m512d estimate = _mm512_mul_pd(_mm512_sub_pd(apex, _mm512_sqrt_pd(mirrored)), splat(1.0 / 3.0));
+    return _mm512_max_pd(floor8(estimate), _mm512_setzero_pd());
+}
+
+/* i = w - s(j), clearing the lanes of *ok where j is not w's row, that is where i is not in
+ * [0, floor((2B - 3j) / 2)), the length of row j (none for j >= rows): for integral i that is
+ * 0 <= i <= B - 1 - 3j/2. Exact: integers and halves below 2^50. */
+static inline SP_AVX512 __m512d row_offset8(__m512d bottom, __m512d j, __m512d w, __mmask8* ok)
+{
+    __m512d i = _mm512_sub_pd(w, row_base8(bottom, j));
+    __m512d last = _mm512_fnmadd_pd(j, splat(1.5), _mm512_sub_pd(bottom, splat(1.0)));
+    *ok = _mm512_mask_cmp_pd_mask(_mm512_cmp_pd_mask(i, _mm512_setzero_pd(), _CMP_GE_OQ) & *ok, i, last, _CMP_LE_OQ);
+    return i;
 }
 
 /* sp_oss_unpack and grid_to_weights for `blocks` blocks of codes <= max_code. */
@@ -317,40 +309,47 @@ static inline __attribute__((always_inline)) SP_AVX512 void decode_chunk8(const 
 {
     double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
     __m512i index[2] = {aos_index(k, 0), aos_index(k, 1)};
-    __m512d code[CHUNK], layer[CHUNK], rest[CHUNK], row[CHUNK];
+    __m512d layer[CHUNK], rest[CHUNK], bottom[CHUNK], row[CHUNK];
     __mmask8 ok[CHUNK];
     for (size_t b = 0; b < blocks; ++b) {
-        code[b] = rest[b] = _mm512_cvtepu64_pd(_mm512_loadu_si512(codes + b * BLOCK)); /* < 2^50: exact */
+        rest[b] = _mm512_cvtepu64_pd(_mm512_loadu_si512(codes + b * BLOCK)); /* < 2^50: exact */
         layer[b] = _mm512_setzero_pd();
+        bottom[b] = splat(n);
         ok[b] = 0xFF;
     }
-    if (k == 4) {
-        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate8(n, code[b]);
-        /* The layer needs no check of its own: with k clamped to the layers, the row check
-         * accepts only a rest = code - u(k) inside layer k's triangle (a negative rest fails
-         * s(j) <= rest, one past the triangle fails rest < s(j + 1) for every row, row
-         * j >= rows has s(j + 1) <= s(j)), and then (k, row, i) is the one tuple whose index
-         * is code. */
-        for (size_t b = 0; b < blocks; ++b) rest[b] = _mm512_sub_pd(code[b], layer_base8(splat(n), layer[b]));
-    }
+    if (k == 4)
+        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate8(n, rest[b]);
+    /* The layer needs no check of its own: with k clamped to the layers, the row check
+     * accepts only a rest = code - u(k) inside layer k's triangle (a negative rest fails
+     * s(j) <= rest, one past the triangle fails rest < s(j + 1) for every row, row
+     * j >= rows has s(j + 1) <= s(j)), and then (k, row, i) is the one tuple whose index
+     * is code. */
     if (k > 2)
-        for (size_t b = 0; b < blocks; ++b)
-            row[b] = row_estimate8(_mm512_sub_pd(splat(n), _mm512_add_pd(layer[b], layer[b])), rest[b]);
+        for (size_t b = 0; b < blocks; ++b) {
+            if (k == 4) {
+                rest[b] = _mm512_sub_pd(rest[b], layer_base8(n, layer[b]));
+                bottom[b] = _mm512_fnmadd_pd(layer[b], splat(2.0), splat(n));
+            }
+            row[b] = row_estimate8(bottom[b], rest[b]);
+        }
     for (size_t b = 0; b < blocks; ++b) {
         __m512d q[SP_MAX_INFLUENCES], grid = splat(2 * (n - 1));
         if (k == 2) {
             q[1] = rest[b];
             q[0] = _mm512_sub_pd(grid, rest[b]);
         } else {
-            __m512d bottom = _mm512_sub_pd(splat(n), _mm512_add_pd(layer[b], layer[b]));
-            __m512d base = row_check8(bottom, row[b], rest[b], &ok[b]);
+            __m512d i = row_offset8(bottom[b], row[b], rest[b], &ok[b]);
             if (k == 4) q[3] = layer[b];
             q[2] = _mm512_add_pd(row[b], layer[b]);
-            q[1] = _mm512_add_pd(_mm512_sub_pd(rest[b], base), q[2]);
+            q[1] = _mm512_add_pd(i, q[2]);
             __m512d sum = _mm512_add_pd(q[1], q[2]);
             q[0] = _mm512_sub_pd(grid, k == 4 ? _mm512_add_pd(sum, layer[b]) : sum);
         }
         store_block8(q, k, inverse, index, weights + b * BLOCK * k);
+    }
+    /* The scalar redo in a pass of its own: a call inside the loop above would clobber every
+     * vector register, and the loop would reload its constants on each block. */
+    for (size_t b = 0; b < blocks; ++b) {
         unsigned slow = ~(unsigned)ok[b] & 0xFF;
         for (size_t lane = b * BLOCK; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_decode_weights(codec, codes[lane], weights + lane * k);

@@ -143,7 +143,8 @@ static void random_tuples(void)
 }
 
 /* N at and just past the largest the vector paths accept (exact there, scalar beyond), and
- * codes at every layer and row start/end there, where the root estimates are off by one. */
+ * codes at every layer and row start/end there, where the root estimates are off by one, and
+ * the last codes, where the layer estimate's cube root argument is smallest. */
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
@@ -165,6 +166,7 @@ static void range_edges(void)
                 if (k > 2 && v % 3 == 1) code = base + sp_oss_row_base(bottom, row + 1) - 1; /* row end */
                 if (k == 4 && v % 7 == 0) code = base - (layer > 0);                  /* layer end */
                 if (k == 4 && v % 11 == 0) code = base;                               /* layer start */
+                if (k == 4 && v % 13 == 0) code = c.max_code - rng_next() % 64;       /* the last layers */
                 codes[v] = code;
             }
             if (compare_decode(&c, codes, count, "edge decode")) return;
