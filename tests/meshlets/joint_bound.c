@@ -8,7 +8,7 @@
  *   is the only one holding j and the only one holding k, so all triangles touching j or k share
  *   it. Joining such joints gives groups whose triangles must fit one meshlet; each group that
  *   does not fit makes at least one of its (disjoint) joints need a second palette entry;
- * - by influence count: a vertex with n used influences puts >= n joints in its meshlet, so at
+ * - by influence count: a vertex with n distinct used joints puts them all in its meshlet, so at
  *   least max(ceil(V_n / max_vertices), ceil(T_n / max_triangles)) meshlets have >= n joints,
  *   V_n counting the vertices with >= n influences and T_n the triangles touching one.
  */
@@ -43,23 +43,37 @@ static int compare_pairs(const void* a, const void* b)
     return (p[1] > q[1]) - (p[1] < q[1]);
 }
 
-/* The used joints of triangle t, each once; returns how many (<= 3 * influences). */
+/* The distinct joints vertex v uses (weight > 0): a repeated joint is one palette entry. */
+static size_t vertex_joints(const meshlet_input* in, size_t v, uint16_t* joints)
+{
+    size_t count = 0;
+    for (size_t s = 0; s < in->influences; ++s) {
+        if (!(in->weights[v * in->influences + s] > 0.0f))
+            continue;
+        uint16_t j = in->joints[v * in->influences + s];
+        size_t seen = 0;
+        while (seen < count && joints[seen] != j)
+            seen++;
+        if (seen == count)
+            joints[count++] = j;
+    }
+    return count;
+}
+
+/* The distinct joints of triangle t (<= 3 * influences), and the most any one corner uses. */
 static size_t triangle_joints(const meshlet_input* in, size_t t, uint16_t* joints, size_t* most_influences)
 {
     size_t count = 0;
     *most_influences = 0;
     for (int c = 0; c < 3; ++c) {
-        size_t v = in->indices[t * 3 + c], used = 0;
-        for (size_t s = 0; s < in->influences; ++s) {
-            if (!(in->weights[v * in->influences + s] > 0.0f))
-                continue;
-            uint16_t j = in->joints[v * in->influences + s];
+        uint16_t corner[8];
+        size_t used = vertex_joints(in, in->indices[t * 3 + c], corner);
+        for (size_t i = 0; i < used; ++i) {
             size_t seen = 0;
-            while (seen < count && joints[seen] != j)
+            while (seen < count && joints[seen] != corner[i])
                 seen++;
             if (seen == count)
-                joints[count++] = j;
-            used++;
+                joints[count++] = corner[i];
         }
         *most_influences = max_size(*most_influences, used);
     }
@@ -124,12 +138,11 @@ int joint_bound_compute(const meshlet_input* in, size_t max_vertices, size_t max
     if (ok) {
         uint16_t joints[3 * 8];
         for (size_t v = 0; v < in->vertex_count; ++v) {
-            size_t used = 0;
-            for (size_t s = 0; s < in->influences; ++s)
-                if (in->weights[v * in->influences + s] > 0.0f) {
-                    joint_vertices[in->joints[v * in->influences + s]]++;
-                    vertices_with[++used]++;
-                }
+            size_t used = vertex_joints(in, v, joints);
+            for (size_t i = 0; i < used; ++i) {
+                joint_vertices[joints[i]]++;
+                vertices_with[i + 1]++;
+            }
         }
         for (size_t t = 0; t < triangle_count; ++t) {
             size_t most, n = triangle_joints(in, t, joints, &most);
