@@ -54,7 +54,7 @@ static inline SP_AVX512 __m512d row_base8(__m512d b, __m512d j)
 
 /* u(k) = floor((3Nk(N - 2k + 3) + k((4k - 9)k + 6) + 2) / 9), for k <= (N + 1)/2, with the
  * numerator a in Horner form ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2: integers below 2^50, so
- * exact, and the last step adds 1/2 as well for floor((a + 1/2) / 9) (exact: see floor_div in
+ * exact, and the last step adds 1/2 as well for floor((a + 1/2) / 9) (exact: see layer_base4 in
  * the AVX2 path). */
 static inline SP_AVX512 __m512d layer_base8(double n, __m512d k)
 {
@@ -120,7 +120,7 @@ static inline SP_AVX512 void store_block8(const __m512d* q, uint32_t k, double i
 
 /* sp_grid_quantize's fast path in eight lanes, same operations in the same order; returns the
  * mask of lanes with a deficit in [0, k), where the scalar takes the same path (see
- * quantize_block in the AVX2 path for why that also makes every step exact). */
+ * quantize_round in the AVX2 path for why that also makes every step exact). */
 static inline SP_AVX512 __mmask8 quantize_block8(const __m512d* w, uint32_t k, double s, __m512d* q)
 {
     __m512d zero = _mm512_setzero_pd(), grid = splat(s), one = splat(1.0);
