@@ -178,7 +178,8 @@ static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)
     }
     if (ctx->used.vertices)
         stats->local_tuple_bits_mean = local_bits / ctx->used.vertices;
-    stats->global_tuples = sp_meshlet_tuple_ids(ctx, (uint64_t*)ctx->builder_scratch, NULL);
+    stats->global_tuples = ctx->global_tuples ? ctx->global_tuples
+                                              : sp_meshlet_tuple_ids(ctx, (uint64_t*)ctx->builder_scratch, NULL);
     stats->global_tuple_bits = sp_index_bits(stats->global_tuples);
 }
 

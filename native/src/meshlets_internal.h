@@ -40,6 +40,7 @@ typedef struct sp_meshlet_context {
     float open_position_sum[3]; /* sum of the open vertices' positions: their centroid drives proximity */
 
     /* output */
+    size_t global_tuples; /* the mesh's unique tuples once a builder has counted them, else 0 */
     sp_meshlet_buffers* out;
     sp_meshlet_sizes used;
 

@@ -325,7 +325,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.vertex_tuple = carve(&cursor, v_count * sizeof(uint32_t));
     size_t tuple_slots = sp_meshlet_tuple_set_slots(v_count);
     s.tuple_stamp = carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
-    sp_meshlet_tuple_ids(ctx, carve(&cursor, tuple_slots * sizeof(uint64_t)), s.vertex_tuple);
+    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, carve(&cursor, tuple_slots * sizeof(uint64_t)), s.vertex_tuple);
     memset(s.tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
     s.open_stamp = 1;
     s.open_tuple_count = 0;

@@ -144,12 +144,7 @@ static row bench_ours(const mesh_data* mesh, const char* name, uint32_t builder,
 {
     meshlet_input in = {mesh->indices, mesh->index_count, mesh->positions, mesh->vertex_count, mesh->joints,
                         mesh->weights, mesh->influences};
-    sp_meshlet_options o;
-    sp_meshlet_options_default(&o);
-    o.builder = builder;
-    o.max_vertices = MAX_VERTICES;
-    o.max_triangles = MAX_TRIANGLES;
-    o.max_joints = palette;
+    sp_meshlet_options o = meshlet_options(builder, MAX_VERTICES, MAX_TRIANGLES, palette);
     meshlet_run run;
     row r = {name, 0, 0, 0, 0, 0, 0, 0, 1e30, 0};
     meshlet_run_build(&run, &in, &o); /* allocates; the timed calls reuse the buffers */

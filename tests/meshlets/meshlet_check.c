@@ -7,6 +7,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+sp_meshlet_options meshlet_options(uint32_t builder, uint32_t max_vertices, uint32_t max_triangles, uint32_t max_joints)
+{
+    sp_meshlet_options o;
+    sp_meshlet_options_default(&o);
+    o.builder = builder;
+    o.max_vertices = max_vertices;
+    o.max_triangles = max_triangles;
+    o.max_joints = max_joints;
+    return o;
+}
+
 sp_result meshlet_run_build(meshlet_run* run, const meshlet_input* in, const sp_meshlet_options* options)
 {
     memset(run, 0, sizeof(*run));

@@ -25,6 +25,9 @@ typedef struct meshlet_run {
     sp_result result;
 } meshlet_run;
 
+/* sp_meshlet_options_default with the builder and the three limits set. */
+sp_meshlet_options meshlet_options(uint32_t builder, uint32_t max_vertices, uint32_t max_triangles, uint32_t max_joints);
+
 /* Allocates the outputs (with triangle_meshlet) and builds; returns run->result. */
 sp_result meshlet_run_build(meshlet_run* run, const meshlet_input* in, const sp_meshlet_options* options);
 void meshlet_run_free(meshlet_run* run);

@@ -29,12 +29,7 @@ static int check_file(const char* path)
     int failures = 0;
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
         for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l) {
-            sp_meshlet_options o;
-            sp_meshlet_options_default(&o);
-            o.builder = b;
-            o.max_vertices = limits[l][0];
-            o.max_triangles = limits[l][1];
-            o.max_joints = limits[l][2];
+            sp_meshlet_options o = meshlet_options(b, limits[l][0], limits[l][1], limits[l][2]);
             meshlet_run run, again;
             meshlet_run_build(&run, &in, &o);
             char message[256] = "";
@@ -63,11 +58,7 @@ static int check_file(const char* path)
         }
 
     /* the widest triangle: build one meshlet per triangle and take the largest palette */
-    sp_meshlet_options single;
-    sp_meshlet_options_default(&single);
-    single.builder = SP_MESHLETS_NAIVE;
-    single.max_triangles = 1;
-    single.max_joints = SP_MESHLET_MAX_JOINTS;
+    sp_meshlet_options single = meshlet_options(SP_MESHLETS_NAIVE, 64, 1, SP_MESHLET_MAX_JOINTS);
     meshlet_run run;
     meshlet_run_build(&run, &in, &single);
     uint32_t widest = run.stats.max_joints;

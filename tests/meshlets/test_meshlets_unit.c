@@ -160,17 +160,6 @@ static mesh shuffled_copy(const mesh* src, uint32_t seed)
     return m;
 }
 
-static sp_meshlet_options options_for(uint32_t builder, uint32_t max_vertices, uint32_t max_triangles, uint32_t max_joints)
-{
-    sp_meshlet_options o;
-    sp_meshlet_options_default(&o);
-    o.builder = builder;
-    o.max_vertices = max_vertices;
-    o.max_triangles = max_triangles;
-    o.max_joints = max_joints;
-    return o;
-}
-
 static const char* builder_name(uint32_t b)
 {
     return b == SP_MESHLETS_NAIVE ? "naive" : b == SP_MESHLETS_COMMON ? "common" : "skin";
@@ -204,7 +193,7 @@ static void test_every_builder_and_limit(void)
     const uint32_t limits[][3] = {{64, 124, 32}, {64, 124, 12}, {255, 512, 255}, {32, 64, 16}, {3, 1, 12}, {128, 256, 24}};
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
         for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l) {
-            sp_meshlet_options o = options_for(b, limits[l][0], limits[l][1], limits[l][2]);
+            sp_meshlet_options o = meshlet_options(b, limits[l][0], limits[l][1], limits[l][2]);
             sp_meshlet_stats s = build_and_check(&grid, &o, "grid");
             build_and_check(&shuffled, &o, "shuffled grid");
             if (o.max_triangles == 1)
@@ -227,7 +216,7 @@ static void test_bound(void)
 static void test_naive_is_index_order(void)
 {
     mesh grid = make_grid(20);
-    sp_meshlet_options o = options_for(SP_MESHLETS_NAIVE, 64, 124, 255);
+    sp_meshlet_options o = meshlet_options(SP_MESHLETS_NAIVE, 64, 124, 255);
     meshlet_input in = input_of(&grid);
     meshlet_run run;
     meshlet_run_build(&run, &in, &o);
@@ -261,7 +250,7 @@ static void test_common_influences_groups(void)
 {
     mesh grid = make_grid(40);
     meshlet_input in = input_of(&grid);
-    sp_meshlet_options o = options_for(SP_MESHLETS_COMMON, 64, 124, 32);
+    sp_meshlet_options o = meshlet_options(SP_MESHLETS_COMMON, 64, 124, 32);
     o.min_group_triangles = 1;
     meshlet_run run;
     meshlet_run_build(&run, &in, &o);
@@ -284,7 +273,7 @@ static void test_common_influences_groups(void)
             EXPECT(run.out.meshlets[id].joint_count <= K, "group meshlet %u has %u joints", id,
                    run.out.meshlets[id].joint_count);
     }
-    sp_meshlet_options naive = options_for(SP_MESHLETS_NAIVE, 64, 124, 32);
+    sp_meshlet_options naive = meshlet_options(SP_MESHLETS_NAIVE, 64, 124, 32);
     meshlet_run baseline;
     meshlet_run_build(&baseline, &in, &naive);
     EXPECT(run.stats.meshlet_count > baseline.stats.meshlet_count, "grouping should cost meshlets: %zu vs %zu",
@@ -307,8 +296,8 @@ static void test_common_influences_groups(void)
 static void test_skin_builder_quality(void)
 {
     mesh grid = make_grid(64);
-    sp_meshlet_options naive = options_for(SP_MESHLETS_NAIVE, 64, 124, 32);
-    sp_meshlet_options skin = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_options naive = meshlet_options(SP_MESHLETS_NAIVE, 64, 124, 32);
+    sp_meshlet_options skin = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
     sp_meshlet_stats n = build_and_check(&grid, &naive, "quality");
     sp_meshlet_stats s = build_and_check(&grid, &skin, "quality");
     EXPECT(s.mean_joints < n.mean_joints, "skin %.2f joints vs naive %.2f", s.mean_joints, n.mean_joints);
@@ -325,7 +314,7 @@ static void test_degenerate_triangles(void)
     grid.indices[4] = grid.indices[3];                    /* triangle 1: a, a, c */
     grid.indices[9] = grid.indices[10] = grid.indices[11]; /* triangle 3: a point */
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b) {
-        sp_meshlet_options o = options_for(b, 3, 124, 16);
+        sp_meshlet_options o = meshlet_options(b, 3, 124, 16);
         build_and_check(&grid, &o, "degenerate");
         o.max_vertices = 64;
         build_and_check(&grid, &o, "degenerate");
@@ -348,7 +337,7 @@ static void test_palette_limit_error(void)
     joints[3 * K] = 0; /* vertex 3 shares a joint: triangle 0 needs 11 */
     meshlet_input in = {indices, 6, positions, 4, joints, weights, K};
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b) {
-        sp_meshlet_options o = options_for(b, 64, 124, 11);
+        sp_meshlet_options o = meshlet_options(b, 64, 124, 11);
         meshlet_run run;
         meshlet_run_build(&run, &in, &o);
         EXPECT(run.result == SP_ERR_LIMIT_EXCEEDED && run.stats.error_triangle == 1, "%s: %s, triangle %zu",
@@ -384,7 +373,7 @@ static sp_result build_with(const mesh* m, const uint32_t* indices, size_t index
 static void test_invalid_arguments(void)
 {
     mesh grid = make_grid(8);
-    sp_meshlet_options good = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_options good = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
     meshlet_run run;
     for (int shrink = 1; shrink <= 6; ++shrink) {
         sp_result r = build_with(&grid, grid.indices, grid.index_count, 12, K, &good, &run, shrink);
@@ -392,10 +381,10 @@ static void test_invalid_arguments(void)
         meshlet_run_free(&run);
     }
     const sp_meshlet_options bad[] = {
-        options_for(SP_MESHLETS_BUILDER_COUNT, 64, 124, 32), options_for(SP_MESHLETS_SKIN, 2, 124, 32),
-        options_for(SP_MESHLETS_SKIN, 256, 124, 32),         options_for(SP_MESHLETS_SKIN, 64, 0, 32),
-        options_for(SP_MESHLETS_SKIN, 64, 513, 32),          options_for(SP_MESHLETS_SKIN, 64, 124, 0),
-        options_for(SP_MESHLETS_SKIN, 64, 124, 256)};
+        meshlet_options(SP_MESHLETS_BUILDER_COUNT, 64, 124, 32), meshlet_options(SP_MESHLETS_SKIN, 2, 124, 32),
+        meshlet_options(SP_MESHLETS_SKIN, 256, 124, 32),         meshlet_options(SP_MESHLETS_SKIN, 64, 0, 32),
+        meshlet_options(SP_MESHLETS_SKIN, 64, 513, 32),          meshlet_options(SP_MESHLETS_SKIN, 64, 124, 0),
+        meshlet_options(SP_MESHLETS_SKIN, 64, 124, 256)};
     for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
         sp_result r = build_with(&grid, grid.indices, grid.index_count, 12, K, &bad[i], &run, 0);
         EXPECT(r == SP_ERR_INVALID_ARGUMENT, "bad options %zu: %s", i, sp_result_string(r));
@@ -441,7 +430,7 @@ static void test_checker_catches_corruption(void)
 {
     mesh grid = make_grid(24);
     meshlet_input in = input_of(&grid);
-    sp_meshlet_options o = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
     char message[256];
     for (int corruption = 0; corruption < 7; ++corruption) {
         meshlet_run run;
@@ -532,7 +521,7 @@ static mesh make_tube(int rings)
 static void test_tuple_cost(void)
 {
     mesh tube = make_tube(9);
-    sp_meshlet_options o = options_for(SP_MESHLETS_SKIN, 64, 124, 32);
+    sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
     sp_meshlet_stats with_cost = build_and_check(&tube, &o, "tube");
     o.tuple_cost = 0.0f;
     sp_meshlet_stats without = build_and_check(&tube, &o, "tube, tuple_cost 0");
@@ -542,7 +531,7 @@ static void test_tuple_cost(void)
     EXPECT(with_cost.meshlet_count <= without.meshlet_count + 1, "tuple_cost made %zu meshlets, %zu without",
            with_cost.meshlet_count, without.meshlet_count);
     printf("tube: local tuple bits %.2f with tuple_cost %.2f (%zu meshlets), %.2f without (%zu meshlets)\n",
-           with_cost.local_tuple_bits_mean, (double)options_for(SP_MESHLETS_SKIN, 64, 124, 32).tuple_cost,
+           with_cost.local_tuple_bits_mean, (double)meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32).tuple_cost,
            with_cost.meshlet_count, without.local_tuple_bits_mean, without.meshlet_count);
     free_mesh(&tube);
 }
@@ -565,7 +554,7 @@ static void test_joint_lower_bound(void)
                "%d columns: by joint %zu, forced %zu, by count %zu, bound %zu", cases[c].columns, b.by_joint,
                b.forced_splits, b.by_influence_count, b.palette_sum);
         for (uint32_t builder = 0; builder < SP_MESHLETS_BUILDER_COUNT; ++builder) {
-            sp_meshlet_options o = options_for(builder, 64, 124, 32);
+            sp_meshlet_options o = meshlet_options(builder, 64, 124, 32);
             sp_meshlet_stats s = build_and_check(&strip, &o, "strip");
             double palette_sum = s.mean_joints * (double)s.meshlet_count;
             EXPECT(palette_sum + 0.5 >= (double)b.palette_sum, "%s: %.0f palette entries below the bound %zu",
