@@ -12,7 +12,7 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 # Debian packages the build, the tests and the benchmarks need.
 PACKAGES=(cmake make gcc g++ clang libclang-rt-14-dev python3-numpy blender libtinygltf-dev
           glslang-tools mesa-vulkan-drivers libvulkan-dev vulkan-tools libmeshoptimizer-dev
-          gltfpack zlib1g-dev libzstd-dev zstd)
+          gltfpack zlib1g-dev libzstd-dev zstd chromium)
 
 install_packages() {
   local missing=()
@@ -31,7 +31,9 @@ install_packages() {
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
   fi
   # Node tools (Khronos glTF validator), pinned by tools/package-lock.json.
-  if [ -f tools/package.json ] && [ ! -d tools/node_modules ]; then
+  # Reinstalled whenever the lockfile is newer than what node_modules was installed from.
+  if [ -f tools/package.json ] && { [ ! -f tools/node_modules/.package-lock.json ] ||
+       [ tools/package-lock.json -nt tools/node_modules/.package-lock.json ]; }; then
     (cd tools && npm ci --no-audit --no-fund --loglevel=error)
   fi
 }
