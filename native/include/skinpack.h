@@ -35,7 +35,7 @@ extern "C" {
 
 #define SP_VERSION 100 /* 1.0.0 */
 
-#define SP_MAX_INPUT_INFLUENCES 8   /* influences per vertex accepted by sp_prepare_influences */
+#define SP_MAX_INPUT_INFLUENCES 8   /* bins of influence_histogram; the last counts 8 or more influences */
 #define SP_MAX_INFLUENCES 4         /* influences kept per vertex (K) */
 #define SP_MAX_JOINTS 65535         /* joint indices are stored as u16 */
 #define SP_MAX_WEIGHT_BITS 64       /* largest weight code */
@@ -72,7 +72,8 @@ typedef struct sp_prepare_stats {
     size_t pruned_vertices;       /* vertices that had more than K non-zero influences */
     size_t renormalized_vertices; /* vertices whose weight sum was off by more than the tolerance */
     size_t merged_duplicates;     /* joint entries merged because a vertex listed a joint twice */
-    size_t influence_histogram[SP_MAX_INPUT_INFLUENCES + 1]; /* vertices by non-zero influence count, before pruning */
+    size_t influence_histogram[SP_MAX_INPUT_INFLUENCES + 1]; /* vertices by non-zero influence count, before pruning
+                                                               (the last bin: SP_MAX_INPUT_INFLUENCES or more) */
     float max_pruning_error;      /* max over vertices of the L-inf weight change caused by pruning */
     double rms_pruning_error;     /* RMS over vertices of the per-vertex pruning error */
     size_t error_vertex;          /* when the result is an error: the first offending vertex */
@@ -84,7 +85,8 @@ typedef struct sp_prepare_stats {
  * duplicate joints (weights added), drops zero weights, keeps the K largest and renormalises
  * them to sum 1. Unused trailing slots get joint 0 and weight 0.
  *
- * joints, weights: vertex_count * input_stride entries (input_stride 1..8).
+ * joints, weights: vertex_count * input_stride entries (any input_stride >= 1, e.g. all of
+ *   JOINTS_0..n of a glTF file side by side; the cost per vertex grows with input_stride^2).
  * joint_count: number of joints of the skin (1..SP_MAX_JOINTS); every joint index must be below it.
  * sum_tolerance: |sum - 1| above this counts the vertex in renormalized_vertices (all vertices
  *   are renormalised regardless; typical 1e-3).
