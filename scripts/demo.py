@@ -165,7 +165,7 @@ def main():
     addon_utils.enable("io_scene_gltf2", default_set=True)
     if addon_utils.enable("skinpack", default_set=True) is None:
         raise SystemExit("the Skinpack add-on did not enable")
-    from skinpack import storage
+    from skinpack.io import storage
 
     body = build_body()
     rig = build_armature()

@@ -15,7 +15,7 @@ A/B toggle needs to write weights back bit-exactly.
 
 import numpy as np
 
-from . import native
+from .io import native
 
 
 class GatherError(Exception):
@@ -33,7 +33,7 @@ class SkinWeights:
         self.element_groups = None  # (E,) vertex group index of every element
         self.element_weights = None  # (E,) float32 weight of every element, bit-exact
         self.element_joints = None  # (E,) joint index or -1 for a non-deform group
-        self.joints = None  # (V, S) uint16, S = most influences of any vertex (1..8)
+        self.joints = None  # (V, S) uint16, S = most influences of any vertex
         self.weights = None  # (V, S) float32, zero-padded
 
     @property
@@ -152,11 +152,8 @@ def gather(obj):
     if unweighted:
         raise GatherError("%s: %d of %d vertices have no weight on a deform bone of %s (assign them, "
                           "e.g. Weight Paint or Automatic Weights)" % (name, unweighted, vertex_count, armature.name))
+    # Every influence goes to the library, which keeps the K strongest and reports the pruning.
     stride = int(influence_count.max())
-    if stride > native.SP_MAX_INPUT_INFLUENCES:
-        over = int((influence_count > native.SP_MAX_INPUT_INFLUENCES).sum())
-        raise GatherError("%s: %d vertices have more than %d deform influences (up to %d); use Weights > "
-                          "Limit Total first" % (name, over, native.SP_MAX_INPUT_INFLUENCES, stride))
 
     # Dense (V, stride) arrays: slot = rank of the element among its vertex's used elements.
     used_vertices = vertex_of[used]

@@ -16,7 +16,8 @@ are all second halves of quads is not visible. On a triangulated mesh the previe
 
 import numpy as np
 
-from . import gather, native, preview, storage
+from . import gather, preview
+from .io import native, storage
 
 BUILDERS = {'NAIVE': "naive", 'COMMON': "common", 'SKIN': "skin"}
 

@@ -11,7 +11,8 @@ import time
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
-from . import gather, meshlet_preview, native, preview, properties, storage
+from . import gather, meshlet_preview, preview, properties, skin_services
+from .io import native, storage
 
 
 def _active_mesh(context):
@@ -43,51 +44,6 @@ class _Progress:
             self.workspace.status_text_set(None)
 
 
-def compression_options(settings, influences_available):
-    """sp_compress_options from the mesh settings; raises ValueError for an unreachable target."""
-    method = settings.method.lower()
-    K = min(settings.max_influences, influences_available)
-    if settings.budget == 'ERROR':
-        bits = native.weight_bits_for_error(method, K, settings.max_error)
-        if bits is None:
-            raise ValueError("no %s configuration reaches a max error of %g" % (method, settings.max_error))
-        return native.make_options(method, settings.max_influences, weight_bits=bits)
-    bits = settings.custom_bits if settings.budget == 'CUSTOM' else int(settings.budget)
-    return native.make_options(method, settings.max_influences, vertex_bits=bits)
-
-
-def compress_object(obj):
-    """Reads, compresses and stores; returns the stored result. Raises GatherError,
-    SkinpackError or ValueError with messages that name the object."""
-    skin = gather.gather(obj)
-    settings = obj.data.skinpack
-    try:
-        options = compression_options(settings, skin.weights.shape[1])
-        compressed = native.compress(skin.joints, skin.weights, len(skin.joint_names), options)
-    except native.SkinpackError as error:
-        if error.code in native.PER_VERTEX_ERRORS:
-            detail = " (vertex %d)" % error.vertex
-        else:
-            detail = " (%s, %s)" % (settings.method.lower(), _budget_text(settings))
-        raise native.SkinpackError("%s: %s%s" % (obj.name, error, detail), error.code, error.vertex)
-    except ValueError as error:
-        raise ValueError("%s: %s" % (obj.name, error))
-    return storage.save_result(obj.data, compressed, skin, settings.options_summary())
-
-
-def _budget_text(settings):
-    if settings.budget == 'ERROR':
-        return "max error %g" % settings.max_error
-    bits = settings.custom_bits if settings.budget == 'CUSTOM' else int(settings.budget)
-    return "%d bits per vertex for tuple index and weights" % bits
-
-
-def stats_line(stats):
-    return ("%s: %.1f -> %.1f bits/vertex (%.1fx), %d tuples, max error %.2e, RMS %.2e"
-            % (stats["method"].upper(), stats["input_bits_per_vertex"], stats["bits_per_vertex"], stats["ratio"],
-               stats["unique_tuples"], stats["max_error"], stats["rms_error"]))
-
-
 class SKINPACK_OT_compress(bpy.types.Operator):
     """Compress the skin weights of the active mesh and store the result with the mesh"""
     bl_idname = "skinpack.compress"
@@ -110,18 +66,22 @@ class SKINPACK_OT_compress(bpy.types.Operator):
         start = time.perf_counter()
         try:
             progress.step(0, "compressing %s" % obj.name)
-            result = compress_object(obj)
+            result = skin_services.compress_object(obj)
             progress.step(2, "done")
             if preview.legend(obj.data) is not None:
                 # The heat map showed the previous result; it is redrawn from the new one.
-                values, scale = preview.weight_errors(obj, result)
-                preview.write_heat_map(obj, values, scale, 'WEIGHT')
+                values, scale, extra = preview.weight_errors(obj, result)
+                preview.write_heat_map(obj, values, scale, 'WEIGHT', extra)
         except (gather.GatherError, native.SkinpackError, ValueError) as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         finally:
             progress.end()
-        self.report({'INFO'}, "%s: %s (%.2f s)" % (obj.name, stats_line(result.stats), time.perf_counter() - start))
+        self.report({'INFO'}, "%s: %s (%.2f s)" % (obj.name, skin_services.stats_line(result.stats),
+                                                  time.perf_counter() - start))
+        pruning = skin_services.pruning_text(result.stats)
+        if pruning:
+            self.report({'WARNING'}, "%s: %s" % (obj.name, pruning))
         return {'FINISHED'}
 
 
@@ -151,17 +111,18 @@ class SKINPACK_OT_preview_error(bpy.types.Operator):
         try:
             progress.step(0, "measuring the %s error of %s" % (self.mode.lower(), obj.name))
             if self.mode == 'WEIGHT':
-                values, scale = preview.weight_errors(obj, result)
+                values, scale, extra = preview.weight_errors(obj, result)
             else:
-                values, scale = preview.pose_errors(context, obj, result)
+                values, scale, extra = preview.pose_errors(context, obj, result)
         except (preview.PreviewError, gather.GatherError, native.SkinpackError) as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         finally:
             progress.end()
-        preview.write_heat_map(obj, values, scale, self.mode)
+        preview.write_heat_map(obj, values, scale, self.mode, extra)
         preview.show_in_viewports(context, obj.data)
-        self.report({'INFO'}, "%s: %s, max %.3g" % (obj.name, preview.MODE_LABELS[self.mode], float(values.max())))
+        label = preview.mode_label(obj.data[storage.PREVIEW_KEY])
+        self.report({'INFO'}, "%s: %s, max %.3g" % (obj.name, label, float(values.max())))
         return {'FINISHED'}
 
 
@@ -248,10 +209,10 @@ class SKINPACK_OT_toggle_decoded(bpy.types.Operator):
         try:
             progress.step(0, "swapping the weights of %s" % obj.name)
             if storage.showing_decoded(mesh):
-                restore_originals(obj)
+                skin_services.restore_originals(obj)
                 self.report({'INFO'}, "%s: original weights restored" % obj.name)
             else:
-                show_decoded(obj)
+                skin_services.show_decoded(obj)
                 self.report({'INFO'}, "%s: showing decoded weights" % obj.name)
         except (gather.GatherError, native.SkinpackError, preview.PreviewError) as error:
             self.report({'ERROR'}, str(error))
@@ -260,40 +221,6 @@ class SKINPACK_OT_toggle_decoded(bpy.types.Operator):
             progress.end()
         mesh.update()
         return {'FINISHED'}
-
-
-def show_decoded(obj):
-    mesh = obj.data
-    result = storage.load_result(mesh)
-    if result is None or storage.is_stale(mesh, result):
-        raise preview.PreviewError("%s: no up-to-date compression result; press Compress first" % obj.name)
-    skin = gather.gather(obj)
-    if not storage.matches_weights(result, skin):
-        raise preview.PreviewError("%s: the weights or deform bones changed since compression; compress again"
-                                   % obj.name)
-    decoded_joints, decoded_weights = result.decode()
-    decoded = gather.decoded_element_weights(skin, decoded_joints, decoded_weights)
-    storage.save_originals(mesh, skin.element_counts, skin.element_groups, skin.element_weights)
-    try:
-        gather.write_element_weights(mesh, skin.element_counts, decoded, skin.element_weights)
-    except Exception:
-        # Whatever was written so far goes back; unchanged elements are skipped.
-        _, _, partial = gather.read_elements(mesh)
-        gather.write_element_weights(mesh, skin.element_counts, skin.element_weights, partial)
-        storage.clear_originals(mesh)
-        raise
-
-
-def restore_originals(obj):
-    mesh = obj.data
-    counts, groups, weights = storage.load_originals(mesh)
-    current_counts, current_groups, current_weights = gather.read_elements(mesh)
-    if not (len(counts) == len(current_counts) and (counts == current_counts).all()
-            and (groups == current_groups).all()):
-        raise preview.PreviewError("%s: vertices or group memberships changed while the decoded weights were "
-                                   "shown; originals kept in the mesh's '%s' property" % (obj.name, storage.ORIGINAL_KEY))
-    gather.write_element_weights(mesh, counts, weights, current_weights)
-    storage.clear_originals(mesh)
 
 
 class SKINPACK_OT_export_gltf(bpy.types.Operator):
@@ -341,27 +268,49 @@ class SKINPACK_OT_export_gltf(bpy.types.Operator):
         saved_settings = (export.enabled, export.mode)
         saved_selection = [(o, o.select_get()) for o in context.view_layer.objects]
         filepath = bpy.path.abspath(self.filepath)
-        export_format = 'GLTF_SEPARATE' if filepath.lower().endswith(".gltf") else 'GLB'
+        options = _all_influences_options()
+        options["export_format"] = 'GLTF_SEPARATE' if filepath.lower().endswith(".gltf") else 'GLB'
         try:
             export.enabled, export.mode = True, self.mode
             for o, _ in saved_selection:
                 o.select_set(o == obj or o == armature)
-            exporter.last_report.clear()
-            bpy.ops.export_scene.gltf(filepath=filepath, export_format=export_format, use_selection=True)
+            bpy.ops.export_scene.gltf(filepath=filepath, use_selection=True, **options)
         except RuntimeError as error:
-            self.report({'ERROR'}, "glTF export of %s failed: %s" % (obj.name, str(error).strip().splitlines()[-1]))
+            problems = exporter.last_report.errors or [_exception_message(error)]
+            self.report({'ERROR'}, "glTF export of %s failed: %s" % (obj.name, "; ".join(problems)))
             return {'CANCELLED'}
         finally:
+            exporter.restore_previews()
             export.enabled, export.mode = saved_settings
             for o, selected in saved_selection:
                 o.select_set(selected)
-        report = list(exporter.last_report)
-        if not report or any("error" in entry for entry in report):
-            problems = "; ".join(entry.get("error", "") for entry in report) or "no skinned primitive found"
-            self.report({'ERROR'}, "%s written without SKINPACK_packed_skin: %s" % (filepath, problems))
+        report = exporter.last_report
+        for warning in report.warnings():
+            self.report({'WARNING'}, warning)
+        if report.errors or not report.compressed:
+            problems = "; ".join(report.errors) or "no skinned primitive found"
+            self.report({'ERROR'}, "%s written without SKINPACK_packed_skin for some meshes: %s" % (filepath, problems))
             return {'CANCELLED'}
-        self.report({'INFO'}, "%s: %d skinned primitives compressed (%s)" % (filepath, len(report), self.mode.lower()))
+        self.report({'INFO'}, "%s: %s" % (filepath, report.summary()))
         return {'FINISHED'}
+
+
+def _all_influences_options():
+    """Every influence goes into the export (the library keeps the K strongest and says so):
+    export_all_influences up to 4.x, export_influence_nb where that replaced it."""
+    properties = bpy.ops.export_scene.gltf.get_rna_type().properties
+    if "export_all_influences" in properties:
+        return {"export_all_influences": True}
+    if "export_influence_nb" in properties:
+        return {"export_influence_nb": int(properties["export_influence_nb"].hard_max)}
+    return {}
+
+
+def _exception_message(error):
+    """The exception line of an operator's RuntimeError (not the traceback's 'Location:' line)."""
+    lines = [line.strip() for line in str(error).splitlines()]
+    lines = [line for line in lines if line and not line.startswith(("Location:", "File ", "Traceback"))]
+    return lines[-1] if lines else "unknown error"
 
 
 classes = (SKINPACK_OT_compress, SKINPACK_OT_preview_error, SKINPACK_OT_preview_meshlets,

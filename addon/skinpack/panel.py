@@ -2,7 +2,8 @@
 
 import bpy
 
-from . import gather, meshlet_preview, native, preview, properties, storage
+from . import gather, meshlet_preview, preview, properties, skin_services
+from .io import native, storage
 
 
 class SKINPACK_PT_skin(bpy.types.Panel):
@@ -10,7 +11,8 @@ class SKINPACK_PT_skin(bpy.types.Panel):
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
     bl_context = "data"
-    bl_options = {'DEFAULT_CLOSED'}
+    # Open from the start (it used to start collapsed). It still comes after Blender's own Object
+    # Data panels: bl_order cannot go below their 0, and equal orders keep registration order.
 
     @classmethod
     def poll(cls, context):
@@ -72,10 +74,12 @@ def _draw_stats(layout, mesh, result):
     if storage.is_stale(mesh, result):
         box.label(text="Stored result is out of date: compress again", icon='ERROR')
     grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
+    per_vertex_data = stats["tuple_bits"] + stats["weight_bits"] > 0
     rows = (
         ("Method", "%s, K = %d" % (stats["method"].upper(), stats["influences"])),
-        ("Bits / vertex", "%.1f \u2192 %.1f" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"])),
-        ("Ratio", "%.1f : 1" % stats["ratio"]),
+        ("Bits / vertex", "%.1f \u2192 %.1f" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"])
+         if per_vertex_data else "%.1f \u2192 0 (one joint tuple)" % stats["input_bits_per_vertex"]),
+        ("Ratio", "%.1f : 1" % stats["ratio"] if per_vertex_data else "only the tuple table is stored"),
         ("Unique joint tuples", "%d" % stats["unique_tuples"]),
         ("Tuple / weight bits", "%d + %d" % (stats["tuple_bits"], stats["weight_bits"])),
         ("Max weight error", "%.2e" % stats["max_error"]),
@@ -85,17 +89,31 @@ def _draw_stats(layout, mesh, result):
     for label, value in rows:
         grid.label(text=label)
         grid.label(text=value)
+    pruning = skin_services.pruning_text(stats)
+    if pruning:
+        box.label(text=pruning, icon='INFO')
+
+
+def ramp_ticks(scale, number_format):
+    """One label per ramp swatch: the value at which the ramp reaches that swatch's colour
+    (0, scale/4, ..., scale); the last swatch also stands for everything above the scale."""
+    steps = len(preview.RAMP) - 1
+    labels = []
+    for index in range(len(preview.RAMP)):
+        value = scale * index / steps
+        labels.append(number_format % value if value else "0")
+    labels[-1] = "\u2265 " + labels[-1]
+    return labels
 
 
 def _draw_ramp(box, context, scale, number_format):
-    """The heat-map colour ramp as swatches with 0, scale/2 and scale under it."""
-    swatches = box.row(align=True)
+    """The heat-map colour ramp as swatches, each with its value right under it (same columns)."""
     legend = context.window_manager.skinpack_legend
+    grid = box.grid_flow(row_major=True, columns=len(preview.RAMP), even_columns=True, align=True)
     for index in range(len(preview.RAMP)):
-        swatches.prop(legend, "color_%d" % index, text="")
-    ticks = box.row()
-    for value in (0, scale / 2, scale):
-        ticks.label(text=number_format % value if value else "0")
+        grid.prop(legend, "color_%d" % index, text="")
+    for label in ramp_ticks(scale, number_format):
+        grid.label(text=label)
 
 
 def _draw_preview(layout, context, mesh):

@@ -33,7 +33,7 @@ class SkinpackMeshSettings(bpy.types.PropertyGroup):
     max_error: FloatProperty(name="Max Weight Error", default=0.001, min=1e-9, max=0.5, precision=5,
                              description="Largest allowed weight error (L-inf); picks the fewest weight bits "
                                          "whose proven bound meets it")
-    max_influences: IntProperty(name="Max Influences", default=4, min=1, max=4,
+    max_influences: IntProperty(name="Max Influences", default=4, min=1, max=4,  # the format's K range
                                 description="Influences kept per vertex (K); the smallest weights are pruned")
 
     def options_summary(self):
@@ -42,8 +42,9 @@ class SkinpackMeshSettings(bpy.types.PropertyGroup):
 
 
 class SkinpackExportSettings(bpy.types.PropertyGroup):
-    enabled: BoolProperty(name="Skinpack", default=True,
-                          description="Write SKINPACK_packed_skin for every skinned primitive")
+    enabled: BoolProperty(name="Skinpack", default=False,
+                          description="Also write SKINPACK_packed_skin for every skinned primitive of this glTF "
+                                      "export (off: the exporter's file is left as Blender writes it)")
     mode: EnumProperty(name="Mode", default='FALLBACK', items=(
         ('FALLBACK', "Fallback", "Keep JOINTS_0/WEIGHTS_0 so every viewer opens the file; the extension is optional"),
         ('COMPACT', "Compact", "Drop JOINTS_0/WEIGHTS_0; the extension is required to read the skin"),

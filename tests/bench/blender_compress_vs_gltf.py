@@ -32,7 +32,8 @@ def timed(function, repeat):
 def main():
     args = common.arguments()
     common.install_addon(args.zip)
-    from skinpack import gather, storage
+    from skinpack import gather
+    from skinpack.io import storage
 
     obj = common.open_asset(args, "RE_Player_female.blend", "RE_Player")
     subdivision = obj.modifiers.new("bench_subdivision", 'SUBSURF')

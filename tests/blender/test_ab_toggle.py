@@ -24,7 +24,8 @@ def evaluated_positions(obj):
 def main():
     args = common.arguments()
     common.install_addon(args.zip)
-    from skinpack import gather, storage
+    from skinpack import gather
+    from skinpack.io import storage
 
     obj = common.open_asset(args, "RE_Player_female.blend", "RE_Player")
     before = common.weight_snapshot(obj.data)

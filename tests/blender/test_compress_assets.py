@@ -43,9 +43,10 @@ def check_stats(name, stats, budget_bits):
 def check_heat_map(obj, result):
     """The colour attribute is the ramp applied to the library's per-vertex errors, and those
     equal what the library reports for the same weights right now."""
-    from skinpack import gather, native, operators, preview
+    from skinpack import gather, preview, skin_services
+    from skinpack.io import native
     skin = gather.gather(obj)
-    options = operators.compression_options(obj.data.skinpack, skin.weights.shape[1])
+    options = skin_services.compression_options(obj.data.skinpack.options_summary(), skin.weights.shape[1])
     fresh = native.compress(skin.joints, skin.weights, len(skin.joint_names), options)
     common.check(np.array_equal(fresh.per_vertex_error, result.per_vertex_error),
                  "%s: stored per-vertex errors differ from the library's" % obj.name)
@@ -63,7 +64,7 @@ def check_heat_map(obj, result):
 def main():
     args = common.arguments()
     common.install_addon(args.zip)
-    from skinpack import storage
+    from skinpack.io import storage
 
     for blend, names in ASSETS:
         for name in names:

@@ -47,7 +47,8 @@ def distinct_rows(rows):
 
 def reference_meshlets(obj, builder):
     """A second, independent call of the library on the same input."""
-    from skinpack import meshlet_preview, native
+    from skinpack import meshlet_preview
+    from skinpack.io import native
     inputs = meshlet_preview.read_inputs(obj, obj.data.skinpack.max_influences)
     options = native.meshlet_options(meshlet_preview.BUILDERS[builder], LIMITS["max_vertices"],
                                      LIMITS["max_triangles"], LIMITS["palette_size"])
@@ -55,7 +56,8 @@ def reference_meshlets(obj, builder):
 
 
 def check_preview(obj, builder, mode):
-    from skinpack import native, preview
+    from skinpack import preview
+    from skinpack.io import native
     what = "%s %s %s" % (obj.name, builder, mode)
     mesh = obj.data
     attribute = mesh.color_attributes.get(preview.MESHLET_ATTRIBUTE_NAME)

@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 def main():
     args = common.arguments()
     common.install_addon(args.zip)
-    from skinpack import native
+    from skinpack.io import native
 
     common.check(native.load() is not None, "library did not load: %s" % native.load_error())
     layout = json.loads(subprocess.check_output([args.layout], text=True))

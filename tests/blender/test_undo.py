@@ -17,7 +17,7 @@ import bpy  # noqa: E402
 def main():
     args = common.arguments()
     common.install_addon(args.zip)
-    from skinpack import storage
+    from skinpack.io import storage
 
     blend = common.asset(args, "skinned_cylinder.blend")
     bpy.ops.wm.append(directory=blend + "/Object/", files=[{"name": "Root"}, {"name": "Cylinder"}])

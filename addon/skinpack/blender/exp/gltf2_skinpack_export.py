@@ -1,29 +1,66 @@
-"""glTF export user extension: writes SKINPACK_packed_skin for every skinned primitive.
+"""glTF export user extension: writes SKINPACK_packed_skin for the skinned meshes, when asked.
 
-Blender's exporter has no per-primitive hook. gather_mesh_hook remembers which Blender mesh
-(and so which Skinpack settings) each glTF mesh came from; gather_gltf_hook then walks the
-finished scene graph, where every skinned node knows its skin and so the joint count
-(including the neutral joint the exporter adds for unweighted vertices), reads the exporter's
-own JOINTS_n/WEIGHTS_n accessors and compresses them with the library. Binary data added
-there is still laid out into the buffer (gather_gltf_extensions_hook would be too late).
+Opt-in: nothing is compressed unless the scene's Skinpack export setting is on (off by
+default; the one-click Export Compressed glTF operator turns it on for its own export).
 
-An exception in a hook is swallowed by the exporter (3.4), so problems are collected in
-`last_report` and the one-click operator turns them into an error.
+Blender's exporter has no per-primitive hook. gather_mesh_hook copies what it needs at once,
+as plain values: the object's name, its mesh's Skinpack settings and the exporter's own
+JOINTS_n/WEIGHTS_n arrays (with Apply Modifiers the mesh it gets is a temporary copy that is
+freed before the export ends). gather_gltf_hook then walks the finished scene graph, where every
+skinned node knows its skin and so the joint count (including the neutral joint the exporter
+adds for unweighted vertices), compresses with the library and adds the binary data while it
+is still laid out into the buffer.
+
+Around every export (module-level callbacks on the add-on, skinpack/__init__.py):
+- the pre-export callback takes Skinpack's preview colour attributes off the meshes, so no
+  colour setting of any version writes them, and refuses Draco (Draco reorders the vertices
+  after our arrays were read, so the extension would not match the file's vertices);
+- the post-export callback, which runs before the file is written, puts the previews back and
+  fails the export when a Compact export could not compress every skinned primitive.
+Problems are reported by object name through export_settings['log'] (4.2+, with a popup),
+the console, `last_report` (the operator and the panel read it) and `is_critical` (5.2+).
 """
 
 import bpy
 import numpy as np
 
-from ... import native, preview
-from ..com import gltf2_skinpack_io as io
+from ... import preview, skin_services
+from ...io import extension as ext
+from ...io import native
+from ..com import gltf2_skinpack_io as gltf_api
 
-# One entry per compressed primitive ({"mesh", "stats"}) or failure ({"mesh", "error"}) of
-# the latest export, for the operator and the tests.
-last_report = []
+
+class ExportReport:
+    """What the latest export compressed, pruned and refused, by object name."""
+
+    def __init__(self):
+        self.compressed = []  # (object name, stats dict)
+        self.errors = []  # messages naming the object
+        self.compact = False
+
+    def clear(self, compact=False):
+        self.compressed.clear()
+        self.errors.clear()
+        self.compact = compact
+
+    def warnings(self):
+        return ["%s: %s" % (name, skin_services.pruning_text(stats))
+                for name, stats in self.compressed if stats["pruned_vertices"]]
+
+    def summary(self):
+        if not self.compressed:
+            return "no skinned primitive compressed"
+        names = sorted({name for name, _ in self.compressed})
+        return "%d skinned primitives compressed (%s): %s" % (
+            len(self.compressed), "compact" if self.compact else "fallback", ", ".join(names))
+
+
+# The latest export's report, for the operator, the panel and the tests.
+last_report = ExportReport()
 
 
 def _read_accessor(accessor):
-    dtype = io.NUMPY_COMPONENTS[int(accessor.component_type)]
+    dtype = ext.NUMPY_COMPONENTS[int(accessor.component_type)]
     width = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[str(accessor.type)]
     data = np.frombuffer(accessor.buffer_view.data, dtype=dtype, count=accessor.count * width,
                          offset=accessor.byte_offset or 0)
@@ -31,15 +68,19 @@ def _read_accessor(accessor):
 
 
 def _skin_arrays(attributes):
-    """(joints (V, 4n) uint16, weights (V, 4n) float32) from JOINTS_0..n / WEIGHTS_0..n."""
+    """Copies of (joints (V, 4n) uint16, weights (V, 4n) float32) from every JOINTS_n/WEIGHTS_n
+    (all influences, whatever the exporter's influence setting wrote), or (None, None)."""
     joints, weights = [], []
     index = 0
     while "JOINTS_%d" % index in attributes and "WEIGHTS_%d" % index in attributes:
-        joints.append(_read_accessor(attributes["JOINTS_%d" % index]).astype(np.uint16))
+        joint_accessor = attributes["JOINTS_%d" % index]
         accessor = attributes["WEIGHTS_%d" % index]
+        if joint_accessor.buffer_view is None or accessor.buffer_view is None:
+            return None, None  # already compressed (a shared attributes dict) or encoded by others
+        joints.append(_read_accessor(joint_accessor).astype(np.uint16))
         values = _read_accessor(accessor).astype(np.float32)
         if accessor.normalized:
-            values = values / io.NORMALIZED_SCALE[int(accessor.component_type)]
+            values = values / ext.NORMALIZED_SCALE[int(accessor.component_type)]
         weights.append(values)
         index += 1
     if not joints:
@@ -47,68 +88,36 @@ def _skin_arrays(attributes):
     return np.concatenate(joints, axis=1), np.concatenate(weights, axis=1)
 
 
-def _accessor(data, component_type, width, bounds=False):
+def _accessor(field):
     """An accessor on its own bufferView (no target: these are not bindable vertex attributes)."""
-    gltf2_io = io.gltf_io()
-    BinaryData = io.binary_data_class()
-    data = np.ascontiguousarray(data)
-    rows = data.reshape(-1, width)
+    gltf2_io = gltf_api.gltf_io()
+    BinaryData = gltf_api.binary_data_class()
+    rows = field.data.reshape(-1, field.width)
     minimum = maximum = None
-    if bounds and len(rows):
+    if field.bounds and len(rows):
         # Python floats: the exporter's Accessor.to_dict asserts float bounds (and no numpy scalars).
         minimum = [float(v) for v in rows.min(axis=0)]
         maximum = [float(v) for v in rows.max(axis=0)]
-    return gltf2_io.Accessor(buffer_view=BinaryData(data.tobytes()), byte_offset=None,
-                             component_type=component_type, count=int(len(rows)), extensions=None,
+    return gltf2_io.Accessor(buffer_view=BinaryData(field.data.tobytes()), byte_offset=None,
+                             component_type=field.component_type, count=int(len(rows)), extensions=None,
                              extras=None, max=maximum, min=minimum, name=None, normalized=None, sparse=None,
-                             type=io.VECTOR_TYPES[width])
+                             type=ext.VECTOR_TYPES[field.width])
 
 
 def _placeholder_accessor(component_type, count):
     """Compact mode: JOINTS_0/WEIGHTS_0 stay in attributes as accessors without a bufferView
     (count, componentType, type only), as KHR_draco_mesh_compression does, so validators and
     readers still see a skinned mesh; the data comes from the extension."""
-    gltf2_io = io.gltf_io()
+    gltf2_io = gltf_api.gltf_io()
     return gltf2_io.Accessor(buffer_view=None, byte_offset=None, component_type=component_type, count=int(count),
                              extensions=None, extras=None, max=None, min=None, name=None, normalized=None,
                              sparse=None, type="VEC4")
 
 
 def extension_json(compressed, joint_count):
-    """The extension object of docs/extension/CONTRACT.md (accessors still as objects)."""
-    skin = compressed.skin
-    K = int(skin.influences)
-    words_per_vertex = int(skin.words_per_vertex)
-    if joint_count <= 256:
-        lut = compressed.lut.astype("<u1")
-        lut_type = io.COMPONENT_UNSIGNED_BYTE
-    else:
-        lut = compressed.lut.astype("<u2")
-        lut_type = io.COMPONENT_UNSIGNED_SHORT
-    data = {
-        "vertices": _accessor(compressed.words.astype("<u4"), io.COMPONENT_UNSIGNED_INT, words_per_vertex),
-        "tupleTable": _accessor(lut, lut_type, K, bounds=True),
-        "influences": K,
-        "jointCount": int(joint_count),
-        "method": compressed.method,
-        "n": int(skin.codec.n),
-        "weightBits": int(skin.weight_bits),
-        "tupleBits": int(skin.tuple_bits),
-        "maxError": float(skin.codec.max_error),
-    }
-    if compressed.method == "any":
-        data["axisSamples"] = compressed.axis_samples()
-    return data
-
-
-def _drop_heat_map(gltf_mesh, blender_mesh):
-    """The exporter writes the render colour attribute as COLOR_0; when that is one of Skinpack's
-    previews (error heat map, meshlets) it is a visualisation, not content, and stays out of the file."""
-    colors = blender_mesh.color_attributes
-    index = colors.render_color_index
-    if 0 <= index < len(colors) and colors[index].name in preview.ATTRIBUTE_NAMES:
-        for primitive in gltf_mesh.primitives:
-            primitive.attributes.pop("COLOR_0", None)
+    """The extension object of docs/extension/CONTRACT.md, arrays as exporter accessors."""
+    fields = ext.extension_fields(compressed, joint_count)
+    return {key: _accessor(value) if isinstance(value, ext.ArrayField) else value for key, value in fields.items()}
 
 
 def _walk(nodes):
@@ -117,33 +126,63 @@ def _walk(nodes):
         yield from _walk(node.children)
 
 
+def _log(export_settings, level, message):
+    """Blender 4.2+: the exporter's log, shown in a popup; always the console too."""
+    print("Skinpack: %s" % message)
+    log = export_settings.get("log")
+    if log is not None:
+        getattr(log, level)("Skinpack: %s" % message, popup=True)
+
+
+def _our_extension(export_settings):
+    for extension in export_settings.get("gltf_user_extensions", ()):
+        if isinstance(extension, glTF2ExportUserExtension):
+            return extension
+    return None
+
+
+class MeshSource:
+    """Plain copies, taken in gather_mesh_hook, of what the compression of one glTF mesh needs."""
+
+    def __init__(self, object_name, settings):
+        self.object_name = object_name
+        self.settings = settings  # SkinpackMeshSettings.options_summary() of the object's mesh
+        self.arrays = {}  # id(primitive.attributes) -> (joints, weights)
+
+
 class glTF2ExportUserExtension:
     def __init__(self):
         settings = bpy.context.scene.skinpack_export
         self.enabled = settings.enabled
         self.compact = settings.mode == 'COMPACT'
-        self.mesh_settings = {}  # id(glTF mesh) -> (Blender mesh name, SkinpackMeshSettings)
+        self.is_critical = False  # Blender 5.2+ aborts the export when this is set
+        self.sources = {}  # id(glTF mesh) -> MeshSource
         self.done = {}  # id(primitive attributes) -> Extension, so shared attribute dicts compress once
+        last_report.clear(self.compact)
 
-    def gather_mesh_hook(self, gltf_mesh, blender_mesh, *args):
+    def gather_mesh_hook(self, gltf_mesh, blender_mesh, blender_object, *args):
         # args end with export_settings; the middle changed between versions (skip_filter).
-        if gltf_mesh is None or not isinstance(blender_mesh, bpy.types.Mesh):
+        if not self.enabled or gltf_mesh is None or id(gltf_mesh) in self.sources:
             return
-        _drop_heat_map(gltf_mesh, blender_mesh)
-        if self.enabled:
-            self.mesh_settings[id(gltf_mesh)] = (blender_mesh.name, blender_mesh.skinpack)
+        owner = blender_object.data if getattr(blender_object, "type", None) == 'MESH' else blender_mesh
+        if not isinstance(owner, bpy.types.Mesh):
+            return
+        name = blender_object.name if blender_object is not None else owner.name
+        source = MeshSource(name, owner.skinpack.options_summary())
+        for primitive in gltf_mesh.primitives:
+            joints, weights = _skin_arrays(primitive.attributes)
+            if joints is not None:
+                source.arrays[id(primitive.attributes)] = (joints, weights)
+        self.sources[id(gltf_mesh)] = source
 
     def gather_gltf_hook(self, active_scene_idx, scenes, animations, export_settings):
-        last_report.clear()
         if not self.enabled:
             return
         if native.load() is None:
-            last_report.append({"mesh": "", "error": native.load_error()})
-            print("Skinpack: %s" % native.load_error())
+            self._fail(export_settings, native.load_error())
             return
         # A mesh used by several skinned nodes is compressed once, with the largest joint count.
-        joint_counts = {}
-        meshes = {}
+        joint_counts, meshes = {}, {}
         for scene in scenes:
             for node in _walk(scene.nodes):
                 if node.mesh is not None and node.skin is not None:
@@ -151,44 +190,83 @@ class glTF2ExportUserExtension:
                     meshes[key] = node.mesh
                     joint_counts[key] = max(joint_counts.get(key, 0), len(node.skin.joints))
         for key, mesh in meshes.items():
+            source = self.sources.get(key)
             for primitive in mesh.primitives:
-                self._compress_primitive(mesh, primitive, joint_counts[key])
+                self._compress_primitive(source, mesh, primitive, joint_counts[key], export_settings)
+        for message in last_report.warnings():
+            _log(export_settings, "warning", message)
+        _log(export_settings, "info", last_report.summary())
 
-    def _compress_primitive(self, mesh, primitive, joint_count):
-        from ...operators import compression_options
-        Extension = io.extension_class()
-        name, settings = self.mesh_settings.get(id(mesh), (mesh.name or "", None))
+    def _fail(self, export_settings, message):
+        last_report.errors.append(message)
+        self.is_critical = self.is_critical or self.compact
+        _log(export_settings, "error", message)
+
+    def _compress_primitive(self, source, mesh, primitive, joint_count, export_settings):
         cache_key = id(primitive.attributes)
-        if cache_key in self.done:
-            extension = self.done[cache_key]
-        else:
-            joints, weights = _skin_arrays(primitive.attributes)
-            if joints is None:
+        if cache_key not in self.done:
+            arrays = source.arrays.get(cache_key) if source is not None else None
+            if arrays is None:
+                if "JOINTS_0" in primitive.attributes:
+                    self._fail(export_settings, "%s: the skin of a primitive could not be read; left uncompressed"
+                               % (mesh.name or "<unnamed mesh>"))
                 return
+            joints, weights = arrays
             try:
-                if settings is None:
-                    options = native.make_options("oss", 4, vertex_bits=32)
-                else:
-                    options = compression_options(settings, weights.shape[1])
-                compressed = native.compress(joints, weights, joint_count, options)
+                compressed = skin_services.compress_skin(source.object_name, joints, weights, joint_count,
+                                                         source.settings)
             except (native.SkinpackError, ValueError) as error:
-                message = "%s: %s" % (name, error)
-                last_report.append({"mesh": name, "error": message})
-                print("Skinpack: primitive left uncompressed: %s" % message)
+                self._fail(export_settings, "%s; primitive left uncompressed" % error)
                 return
-            extension = Extension(io.EXTENSION_NAME, extension_json(compressed, joint_count), required=self.compact)
-            self.done[cache_key] = extension
-            stats = native.stats_dict(compressed)
-            last_report.append({"mesh": name, "stats": stats})
+            Extension = gltf_api.extension_class()
+            self.done[cache_key] = Extension(ext.EXTENSION_NAME, extension_json(compressed, joint_count),
+                                             required=self.compact)
+            last_report.compressed.append((source.object_name, native.stats_dict(compressed)))
             if self.compact:
-                for key in [k for k in primitive.attributes if k.startswith(("JOINTS_", "WEIGHTS_"))]:
-                    del primitive.attributes[key]
-                joint_type = io.COMPONENT_UNSIGNED_BYTE if joint_count <= 256 else io.COMPONENT_UNSIGNED_SHORT
-                primitive.attributes["JOINTS_0"] = _placeholder_accessor(joint_type, len(joints))
-                primitive.attributes["WEIGHTS_0"] = _placeholder_accessor(io.COMPONENT_FLOAT, len(joints))
+                self._drop_plain_skin(primitive, joint_count, len(joints))
         if primitive.extensions is None:
             primitive.extensions = {}
-        primitive.extensions[io.EXTENSION_NAME] = extension
+        primitive.extensions[ext.EXTENSION_NAME] = self.done[cache_key]
+
+    @staticmethod
+    def _drop_plain_skin(primitive, joint_count, vertex_count):
+        for key in [k for k in primitive.attributes if k.startswith(("JOINTS_", "WEIGHTS_"))]:
+            del primitive.attributes[key]
+        primitive.attributes["JOINTS_0"] = _placeholder_accessor(ext.joint_component(joint_count), vertex_count)
+        primitive.attributes["WEIGHTS_0"] = _placeholder_accessor(ext.COMPONENT_FLOAT, vertex_count)
+
+
+class ExportRefused(RuntimeError):
+    """Raised from an export callback: the exporter stops and writes no file."""
+
+
+# Previews taken off the meshes by the running export (module level: one export at a time).
+_detached_previews = []
+
+
+def pre_export(export_settings):
+    """glTF2_pre_export_callback: previews off the meshes; Draco refused when Skinpack is on."""
+    extension = _our_extension(export_settings)
+    if extension is not None and extension.enabled and export_settings.get("gltf_draco_mesh_compression"):
+        message = ("Draco mesh compression reorders the vertices after Skinpack reads them; turn off "
+                   "either Draco or Skinpack in the exporter's options (nothing was written)")
+        extension._fail(export_settings, message)
+        raise ExportRefused("Skinpack: " + message)
+    _detached_previews.extend(preview.detach_previews(bpy.data.meshes))
+
+
+def post_export(export_settings):
+    """glTF2_post_export_callback (before the file is written): previews back; a Compact export
+    that left a skinned primitive uncompressed fails instead of writing a file without its skin."""
+    restore_previews()
+    extension = _our_extension(export_settings)
+    if extension is not None and extension.enabled and extension.compact and last_report.errors:
+        raise ExportRefused("Skinpack: Compact export not written: " + "; ".join(last_report.errors))
+
+
+def restore_previews():
+    """Puts back previews an export took off (also after a failed export: the operator, unregister)."""
+    preview.reattach_previews(_detached_previews)
 
 
 class SKINPACK_PT_gltf_export(bpy.types.Panel):
@@ -218,6 +296,7 @@ def draw_settings(layout, context):
     layout.active = settings.enabled
     layout.prop(settings, "mode")
     layout.label(text="Codec and budget: each mesh's Skinpack panel")
+    layout.label(text="Draco must be off: it reorders the vertices")
 
 
 def draw_export_layout(context, layout):
@@ -252,6 +331,7 @@ def register():
 
 def unregister():
     unregister_panel()
+    restore_previews()
     if bpy.app.version >= (4, 2, 0):
         try:
             import io_scene_gltf2

@@ -9,8 +9,9 @@ a Skinpack-aware runtime would use. Decoding (and all its validation) is the lib
 
 import numpy as np
 
-from ... import native
-from ..com import gltf2_skinpack_io as io
+from ...io import extension as ext
+from ...io import native
+from ..com import gltf2_skinpack_io as gltf_api
 
 
 def _decode_accessor(gltf, index):
@@ -20,7 +21,7 @@ def _decode_accessor(gltf, index):
 
 def _append_accessor(gltf, data, component_type, width):
     """Adds a buffer + bufferView + accessor holding data; returns the accessor index."""
-    gltf2_io = io.gltf_io()
+    gltf2_io = gltf_api.gltf_io()
     payload = np.ascontiguousarray(data).tobytes()
     buffers = gltf.data.buffers
     buffer_index = len(buffers)
@@ -32,7 +33,7 @@ def _append_accessor(gltf, data, component_type, width):
     gltf.data.accessors.append(gltf2_io.Accessor(buffer_view=len(gltf.data.buffer_views) - 1, byte_offset=0,
                                                  component_type=component_type, count=int(np.asarray(data).size // width),
                                                  extensions=None, extras=None, max=None, min=None, name=None,
-                                                 normalized=None, sparse=None, type=io.VECTOR_TYPES[width]))
+                                                 normalized=None, sparse=None, type=ext.VECTOR_TYPES[width]))
     return len(gltf.data.accessors) - 1
 
 
@@ -52,20 +53,20 @@ def decode_primitive(gltf, primitive, extension):
     padded_weights[:, :K] = weights
     for key in [k for k in primitive.attributes if k.startswith(("JOINTS_", "WEIGHTS_"))]:
         del primitive.attributes[key]
-    primitive.attributes["JOINTS_0"] = _append_accessor(gltf, padded_joints, io.COMPONENT_UNSIGNED_SHORT, 4)
-    primitive.attributes["WEIGHTS_0"] = _append_accessor(gltf, padded_weights, io.COMPONENT_FLOAT, 4)
+    primitive.attributes["JOINTS_0"] = _append_accessor(gltf, padded_joints, ext.COMPONENT_UNSIGNED_SHORT, 4)
+    primitive.attributes["WEIGHTS_0"] = _append_accessor(gltf, padded_weights, ext.COMPONENT_FLOAT, 4)
 
 
 class glTF2ImportUserExtension:
     def __init__(self):
         # A required extension must be declared, or the importer refuses the file.
-        Extension = io.extension_class()
-        self.extensions = [Extension(name=io.EXTENSION_NAME, extension={}, required=True)]
+        Extension = gltf_api.extension_class()
+        self.extensions = [Extension(name=ext.EXTENSION_NAME, extension={}, required=True)]
         self.decoded = set()  # id() of primitives already decoded (a mesh can be built per skin)
 
     def gather_import_mesh_before_hook(self, pymesh, gltf):
         for primitive in pymesh.primitives:
-            extension = (primitive.extensions or {}).get(io.EXTENSION_NAME)
+            extension = (primitive.extensions or {}).get(ext.EXTENSION_NAME)
             if extension is None or id(primitive) in self.decoded:
                 continue
             if native.load() is None:

@@ -1,201 +1,94 @@
 """ctypes binding of libskinpack (native/include/skinpack.h).
 
-All compression math lives in the C library; this module only mirrors its structs, loads it
-from the add-on's own folder and wraps the few whole-skin calls the add-on needs in functions
-that take and return numpy arrays. The structs below must match skinpack.h field by field:
-tests/blender/test_native_layout.py compares every size and offset with the C compiler's.
+All compression math lives in the C library; this module builds its ctypes structs from the
+layouts generated from skinpack.h (_abi.py), loads a private copy of the library bundled with
+the add-on and wraps the few whole-skin calls the add-on needs in functions that take and
+return numpy arrays. No Blender here. tests/blender/test_native_layout.py compares every size
+and offset with the C compiler's.
 """
 
 import ctypes
+import hashlib
 import os
+import sys
 
 import numpy as np
 
-LIBRARY_NAME = "libskinpack.so"
+from . import _abi  # generated from skinpack.h when the zip is built (addon/generate_abi.py)
 
-SP_MAX_INPUT_INFLUENCES = 8
-SP_MAX_INFLUENCES = 4
-SP_MAX_JOINTS = 65535
-SP_ERROR_HISTOGRAM_BINS = 16
+# The library's file name inside the add-on, per platform (make_zip.py writes it so).
+if sys.platform == "win32":
+    LIBRARY_NAME = "skinpack.dll"
+elif sys.platform == "darwin":
+    LIBRARY_NAME = "libskinpack.dylib"
+else:
+    LIBRARY_NAME = "libskinpack.so"
 
-METHODS = ("fixed", "cube", "pot", "any", "oss")  # index == sp_method value
+_constants = _abi.CONSTANTS
+SP_VERSION = _constants["SP_VERSION"]
+SP_MAX_INPUT_INFLUENCES = _constants["SP_MAX_INPUT_INFLUENCES"]
+SP_MAX_INFLUENCES = _constants["SP_MAX_INFLUENCES"]
+SP_MAX_JOINTS = _constants["SP_MAX_JOINTS"]
+SP_ERROR_HISTOGRAM_BINS = _constants["SP_ERROR_HISTOGRAM_BINS"]
+
+
+def _enum_names(enum, prefix):
+    """Lower-case names of an enum's values by value (SP_METHOD_OSS -> 'oss'), *_COUNT left out."""
+    values = sorted((value, name) for name, value in _abi.ENUMS[enum].items() if not name.endswith("_COUNT"))
+    if [value for value, _ in values] != list(range(len(values))):
+        raise ImportError("%s is not numbered 0..n-1 in skinpack.h" % enum)
+    return tuple(name[len(prefix):].lower() for _, name in values)
+
+
+METHODS = _enum_names("sp_method", "SP_METHOD_")  # index == sp_method value
+MESHLET_BUILDERS = _enum_names("sp_meshlet_builder", "SP_MESHLETS_")  # index == sp_meshlet_builder value
 
 # sp_result values the add-on reacts to (the rest are only shown as messages).
-SP_OK = 0
-SP_ERR_INVALID_ARGUMENT = 1
-SP_ERR_NONFINITE_WEIGHT = 3
-SP_ERR_NEGATIVE_WEIGHT = 4
-SP_ERR_NO_INFLUENCE = 5
-SP_ERR_JOINT_OUT_OF_RANGE = 6
-SP_ERR_LIMIT_EXCEEDED = 13
+_results = _abi.ENUMS["sp_result"]
+SP_OK = _results["SP_OK"]
+SP_ERR_INVALID_ARGUMENT = _results["SP_ERR_INVALID_ARGUMENT"]
+SP_ERR_NONFINITE_WEIGHT = _results["SP_ERR_NONFINITE_WEIGHT"]
+SP_ERR_NEGATIVE_WEIGHT = _results["SP_ERR_NEGATIVE_WEIGHT"]
+SP_ERR_NO_INFLUENCE = _results["SP_ERR_NO_INFLUENCE"]
+SP_ERR_JOINT_OUT_OF_RANGE = _results["SP_ERR_JOINT_OUT_OF_RANGE"]
+SP_ERR_LIMIT_EXCEEDED = _results["SP_ERR_LIMIT_EXCEEDED"]
 # Results whose error_vertex names a vertex (the others are about parameters).
 PER_VERTEX_ERRORS = (SP_ERR_NONFINITE_WEIGHT, SP_ERR_NEGATIVE_WEIGHT, SP_ERR_NO_INFLUENCE, SP_ERR_JOINT_OUT_OF_RANGE)
 
-
-class PrepareStats(ctypes.Structure):
-    _fields_ = [
-        ("vertex_count", ctypes.c_size_t),
-        ("pruned_vertices", ctypes.c_size_t),
-        ("renormalized_vertices", ctypes.c_size_t),
-        ("merged_duplicates", ctypes.c_size_t),
-        ("influence_histogram", ctypes.c_size_t * (SP_MAX_INPUT_INFLUENCES + 1)),
-        ("max_pruning_error", ctypes.c_float),
-        ("rms_pruning_error", ctypes.c_double),
-        ("error_vertex", ctypes.c_size_t),
-        ("error_joint", ctypes.c_uint32),
-    ]
+_SCALARS = {"uint8_t": ctypes.c_uint8, "uint16_t": ctypes.c_uint16, "uint32_t": ctypes.c_uint32,
+            "uint64_t": ctypes.c_uint64, "int": ctypes.c_int, "float": ctypes.c_float, "double": ctypes.c_double,
+            "size_t": ctypes.c_size_t}
 
 
-class Codec(ctypes.Structure):
-    _fields_ = [
-        ("method", ctypes.c_uint32),
-        ("influences", ctypes.c_uint32),
-        ("bits", ctypes.c_uint32),
-        ("component_bits", ctypes.c_uint32 * SP_MAX_INFLUENCES),
-        ("n", ctypes.c_uint64),
-        ("axis_samples", ctypes.c_uint64 * (SP_MAX_INFLUENCES - 1)),
-        ("scale", ctypes.c_uint64),
-        ("max_code", ctypes.c_uint64),
-        ("code_bits", ctypes.c_double),
-        ("max_spacing", ctypes.c_double),
-        ("max_error", ctypes.c_double),
-    ]
+def _build_structs():
+    """ctypes.Structure classes for every struct of skinpack.h, in header order."""
+    built = {}
+    for name, kind in _abi.TYPES.items():
+        if kind != "struct":
+            continue
+        fields = []
+        for field, type_name, pointers, length in _abi.STRUCTS[name]:
+            ctype = _SCALARS.get(type_name) or built.get(type_name)
+            if ctype is None:  # an enum: C gives it the size of int here
+                ctype = ctypes.c_int
+            for _ in range(pointers):
+                ctype = ctypes.POINTER(ctype)
+            fields.append((field, ctype * length if length else ctype))
+        built[name] = type(name, (ctypes.Structure,), {"_fields_": fields})
+    return built
 
 
-class ErrorStats(ctypes.Structure):
-    _fields_ = [
-        ("max_error", ctypes.c_double),
-        ("rms_error", ctypes.c_double),
-        ("mean_error", ctypes.c_double),
-        ("worst_vertex", ctypes.c_size_t),
-        ("histogram_max", ctypes.c_double),
-        ("histogram", ctypes.c_size_t * SP_ERROR_HISTOGRAM_BINS),
-        ("vertices_over_bound", ctypes.c_size_t),
-    ]
-
-
-class CompressOptions(ctypes.Structure):
-    _fields_ = [
-        ("method", ctypes.c_int),  # enum sp_method
-        ("max_influences", ctypes.c_uint32),
-        ("vertex_bits", ctypes.c_uint32),
-        ("weight_bits", ctypes.c_uint32),
-        ("max_spacing", ctypes.c_double),
-        ("merge_dont_care", ctypes.c_int),
-        ("sum_tolerance", ctypes.c_float),
-    ]
-
-
-class CompressedSkin(ctypes.Structure):
-    _fields_ = [
-        ("codec", Codec),
-        ("influences", ctypes.c_uint32),
-        ("tuple_bits", ctypes.c_uint32),
-        ("weight_bits", ctypes.c_uint32),
-        ("words_per_vertex", ctypes.c_uint32),
-        ("joint_bytes", ctypes.c_uint32),
-        ("vertex_count", ctypes.c_size_t),
-        ("joint_count", ctypes.c_size_t),
-        ("lut_size", ctypes.c_size_t),
-        ("lut_bits_per_vertex", ctypes.c_double),
-        ("bits_per_vertex", ctypes.c_double),
-        ("prepare", PrepareStats),
-        ("quantization", ErrorStats),
-    ]
-
-
-# Meshlets (skinpack.h section "Meshlets", docs/meshlets.md).
-MESHLET_BUILDERS = ("naive", "common", "skin")  # index == sp_meshlet_builder value
-
-
-class MeshletOptions(ctypes.Structure):
-    _fields_ = [
-        ("builder", ctypes.c_uint32),
-        ("max_vertices", ctypes.c_uint32),
-        ("max_triangles", ctypes.c_uint32),
-        ("max_joints", ctypes.c_uint32),
-        ("min_group_triangles", ctypes.c_uint32),
-        ("joint_cost", ctypes.c_float),
-        ("tuple_cost", ctypes.c_float),
-    ]
-
-
-class Meshlet(ctypes.Structure):
-    _fields_ = [
-        ("vertex_offset", ctypes.c_uint32),
-        ("triangle_offset", ctypes.c_uint32),
-        ("joint_offset", ctypes.c_uint32),
-        ("tuple_offset", ctypes.c_uint32),
-        ("vertex_count", ctypes.c_uint16),
-        ("triangle_count", ctypes.c_uint16),
-        ("joint_count", ctypes.c_uint16),
-        ("tuple_count", ctypes.c_uint16),
-        ("tuple_bits", ctypes.c_uint32),
-        ("center", ctypes.c_float * 3),
-        ("radius", ctypes.c_float),
-        ("cone_apex", ctypes.c_float * 3),
-        ("cone_axis", ctypes.c_float * 3),
-        ("cone_cutoff", ctypes.c_float),
-    ]
-
-
-class MeshletSizes(ctypes.Structure):
-    _fields_ = [
-        ("meshlets", ctypes.c_size_t),
-        ("vertices", ctypes.c_size_t),
-        ("triangles", ctypes.c_size_t),
-        ("joints", ctypes.c_size_t),
-        ("tuples", ctypes.c_size_t),
-        ("scratch_bytes", ctypes.c_size_t),
-    ]
-
-
-class MeshletBuffers(ctypes.Structure):
-    _fields_ = [
-        ("meshlets", ctypes.POINTER(Meshlet)),
-        ("vertices", ctypes.POINTER(ctypes.c_uint32)),
-        ("vertex_tuples", ctypes.POINTER(ctypes.c_uint8)),
-        ("triangles", ctypes.POINTER(ctypes.c_uint8)),
-        ("joints", ctypes.POINTER(ctypes.c_uint16)),
-        ("tuples", ctypes.POINTER(ctypes.c_uint8)),
-        ("triangle_meshlet", ctypes.POINTER(ctypes.c_uint32)),
-        ("capacity", MeshletSizes),
-    ]
-
-
-class MeshletStats(ctypes.Structure):
-    _fields_ = [
-        ("meshlet_count", ctypes.c_size_t),
-        ("vertex_count", ctypes.c_size_t),
-        ("triangle_count", ctypes.c_size_t),
-        ("joint_count", ctypes.c_size_t),
-        ("tuple_count", ctypes.c_size_t),
-        ("max_vertices", ctypes.c_uint32),
-        ("max_triangles", ctypes.c_uint32),
-        ("max_joints", ctypes.c_uint32),
-        ("mean_vertices", ctypes.c_double),
-        ("mean_triangles", ctypes.c_double),
-        ("mean_joints", ctypes.c_double),
-        ("global_tuples", ctypes.c_size_t),
-        ("global_tuple_bits", ctypes.c_uint32),
-        ("local_tuple_bits_mean", ctypes.c_double),
-        ("local_tuple_bits_max", ctypes.c_uint32),
-        ("error_triangle", ctypes.c_size_t),
-    ]
-
-
-MIRRORED_STRUCTS = {
-    "sp_prepare_stats": PrepareStats,
-    "sp_codec": Codec,
-    "sp_error_stats": ErrorStats,
-    "sp_compress_options": CompressOptions,
-    "sp_compressed_skin": CompressedSkin,
-    "sp_meshlet_options": MeshletOptions,
-    "sp_meshlet": Meshlet,
-    "sp_meshlet_sizes": MeshletSizes,
-    "sp_meshlet_buffers": MeshletBuffers,
-    "sp_meshlet_stats": MeshletStats,
-}
+MIRRORED_STRUCTS = _build_structs()
+PrepareStats = MIRRORED_STRUCTS["sp_prepare_stats"]
+Codec = MIRRORED_STRUCTS["sp_codec"]
+ErrorStats = MIRRORED_STRUCTS["sp_error_stats"]
+CompressOptions = MIRRORED_STRUCTS["sp_compress_options"]
+CompressedSkin = MIRRORED_STRUCTS["sp_compressed_skin"]
+MeshletOptions = MIRRORED_STRUCTS["sp_meshlet_options"]
+Meshlet = MIRRORED_STRUCTS["sp_meshlet"]
+MeshletSizes = MIRRORED_STRUCTS["sp_meshlet_sizes"]
+MeshletBuffers = MIRRORED_STRUCTS["sp_meshlet_buffers"]
+MeshletStats = MIRRORED_STRUCTS["sp_meshlet_stats"]
 
 
 class SkinpackError(Exception):
@@ -209,6 +102,7 @@ class SkinpackError(Exception):
 
 _lib = None
 _load_error = None
+_loaded_path = None
 
 
 def _pointer(array, ctype):
@@ -255,23 +149,74 @@ def _declare(lib):
 
 
 def library_path():
+    """The library as installed with the add-on (an install or update may overwrite it)."""
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), LIBRARY_NAME)
 
 
+_cache_dir = None
+
+
+def set_cache_dir(path):
+    """Where load() keeps its private copy of the library (the Blender side passes a user folder)."""
+    global _cache_dir
+    _cache_dir = path
+
+
+def _private_copy(path):
+    """A copy of the library named by its content hash, in a folder no add-on install touches.
+
+    Reinstalling the zip while the library is mapped (this session or another Blender) rewrites
+    library_path() in place, which crashes the process at its next call into it. A copy named
+    by its content is never rewritten: a new build gets a new name, the same build the same
+    (complete) file, written under a temporary name and renamed into place."""
+    with open(path, "rb") as handle:
+        data = handle.read()
+    stem, extension = os.path.splitext(LIBRARY_NAME)
+    folder = _cache_dir or os.path.join(os.path.expanduser("~"), ".cache", "skinpack")
+    target = os.path.join(folder, "%s-%s%s" % (stem, hashlib.sha256(data).hexdigest()[:16], extension))
+    if not os.path.isfile(target):
+        os.makedirs(folder, exist_ok=True)
+        temporary = "%s.%d.tmp" % (target, os.getpid())
+        with open(temporary, "wb") as handle:
+            handle.write(data)
+        os.replace(temporary, target)
+    return target
+
+
+def _check_version(lib, path):
+    """The library's own version against the header the mirrors were generated from."""
+    if not hasattr(lib, "sp_version"):
+        return
+    lib.sp_version.restype = ctypes.c_uint32
+    lib.sp_version.argtypes = []
+    version = lib.sp_version()
+    if version != SP_VERSION:
+        raise OSError("%s is version %d, the add-on was built for %d; reinstall the add-on zip"
+                      % (path, version, SP_VERSION))
+
+
 def load():
-    """Loads the library once; returns it, or None (load_error() says why)."""
-    global _lib, _load_error
+    """Loads the library once (from its private copy); returns it, or None (load_error() says why)."""
+    global _lib, _load_error, _loaded_path
     if _lib is not None or _load_error is not None:
         return _lib
     path = library_path()
     try:
-        lib = ctypes.CDLL(path)
+        loaded_from = _private_copy(path)
+        lib = ctypes.CDLL(loaded_from)
+        _check_version(lib, path)
         _declare(lib)
     except (OSError, AttributeError) as error:
         _load_error = "Cannot load %s: %s" % (path, error)
         return None
-    _lib = lib
+    _lib, _loaded_path = lib, loaded_from
     return _lib
+
+
+def loaded_path():
+    """The file the library was loaded from, or None."""
+    load()
+    return _loaded_path
 
 
 def load_error():
@@ -296,8 +241,9 @@ def default_options():
     return options
 
 
-def make_options(method="oss", max_influences=4, vertex_bits=0, weight_bits=0, max_spacing=0.0):
-    """Compress options with exactly one budget set (vertex_bits, weight_bits or max_spacing)."""
+def make_options(method, max_influences, vertex_bits=0, weight_bits=0, max_spacing=0.0):
+    """The library's default options with the method, K and exactly one budget set
+    (vertex_bits, weight_bits or max_spacing)."""
     options = default_options()
     options.method = METHODS.index(method)
     options.max_influences = max_influences
@@ -407,6 +353,8 @@ def stats_dict(compressed):
     WEIGHTS_0 (float), VEC4 each."""
     s = compressed.skin
     input_bits_per_vertex = 4 * (8 * s.joint_bytes + 32)
+    histogram = list(s.prepare.influence_histogram)
+    most_influences = max((n for n, count in enumerate(histogram) if count), default=0)
     return {
         "vertices": int(s.vertex_count),
         "joint_count": int(s.joint_count),
@@ -426,6 +374,8 @@ def stats_dict(compressed):
         "rms_error": float(s.quantization.rms_error),
         "error_bound": float(s.codec.max_error),
         "pruned_vertices": int(s.prepare.pruned_vertices),
+        "max_input_influences": most_influences,
+        "max_input_influences_capped": most_influences == SP_MAX_INPUT_INFLUENCES,
         "max_pruning_error": float(s.prepare.max_pruning_error),
         "renormalized_vertices": int(s.prepare.renormalized_vertices),
     }
@@ -451,14 +401,15 @@ def prepare_influences(joints, weights, joint_count, max_influences, sum_toleran
     return out_joints, out_weights
 
 
-def meshlet_options(builder="skin", max_vertices=64, max_triangles=124, max_joints=32):
-    """sp_meshlet_options: the library's defaults with the builder and the three limits set."""
+def meshlet_options(builder=None, max_vertices=None, max_triangles=None, max_joints=None):
+    """sp_meshlet_options: the library's defaults with the builder and the limits that are given."""
     options = MeshletOptions()
     _require().sp_meshlet_options_default(ctypes.byref(options))
-    options.builder = MESHLET_BUILDERS.index(builder)
-    options.max_vertices = max_vertices
-    options.max_triangles = max_triangles
-    options.max_joints = max_joints
+    if builder is not None:
+        options.builder = MESHLET_BUILDERS.index(builder)
+    for name, value in (("max_vertices", max_vertices), ("max_triangles", max_triangles), ("max_joints", max_joints)):
+        if value is not None:
+            setattr(options, name, value)
     return options
 
 

@@ -1,0 +1,54 @@
+"""The SKINPACK_packed_skin extension object (docs/extension/CONTRACT.md) as plain data.
+
+No Blender here: the exporter hook turns the arrays into glTF accessors, the importer reads
+the same fields back. Field names and the LUT's component width are defined once, here.
+"""
+
+import numpy as np
+
+EXTENSION_NAME = "SKINPACK_packed_skin"
+
+COMPONENT_UNSIGNED_BYTE = 5121
+COMPONENT_UNSIGNED_SHORT = 5123
+COMPONENT_UNSIGNED_INT = 5125
+COMPONENT_FLOAT = 5126
+
+VECTOR_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
+NUMPY_COMPONENTS = {COMPONENT_UNSIGNED_BYTE: "<u1", COMPONENT_UNSIGNED_SHORT: "<u2",
+                    COMPONENT_UNSIGNED_INT: "<u4", COMPONENT_FLOAT: "<f4"}
+NORMALIZED_SCALE = {COMPONENT_UNSIGNED_BYTE: 255.0, COMPONENT_UNSIGNED_SHORT: 65535.0}
+
+
+def joint_component(joint_count):
+    """JOINTS_n and LUT entries: u8 up to 256 joints, else u16 (what glTF exporters write)."""
+    return COMPONENT_UNSIGNED_BYTE if joint_count <= 256 else COMPONENT_UNSIGNED_SHORT
+
+
+class ArrayField:
+    """An accessor-to-be: the data, its component type and width, whether min/max are given."""
+
+    def __init__(self, data, component_type, width, bounds=False):
+        self.data = np.ascontiguousarray(data, dtype=NUMPY_COMPONENTS[component_type])
+        self.component_type = component_type
+        self.width = width
+        self.bounds = bounds
+
+
+def extension_fields(compressed, joint_count):
+    """The extension's fields for a native.Compressed skin; arrays as ArrayField."""
+    skin = compressed.skin
+    lut_type = joint_component(joint_count)
+    fields = {
+        "vertices": ArrayField(compressed.words, COMPONENT_UNSIGNED_INT, int(skin.words_per_vertex)),
+        "tupleTable": ArrayField(compressed.lut, lut_type, int(skin.influences), bounds=True),
+        "influences": int(skin.influences),
+        "jointCount": int(joint_count),
+        "method": compressed.method,
+        "n": int(skin.codec.n),
+        "weightBits": int(skin.weight_bits),
+        "tupleBits": int(skin.tuple_bits),
+        "maxError": float(skin.codec.max_error),
+    }
+    if compressed.method == "any":
+        fields["axisSamples"] = compressed.axis_samples()
+    return fields

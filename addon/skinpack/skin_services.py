@@ -1,0 +1,114 @@
+"""Skin services shared by the operators and the glTF exporter hook (no operators here).
+
+Options from a mesh's settings, Compress, the texts that describe a result (stats, pruning),
+and swapping the decoded weights in and out for the A/B view. Every function raises
+GatherError, SkinpackError, PreviewError or ValueError with a message that names the object;
+callers decide how to show it (operator report, export log).
+"""
+
+from . import gather, preview
+from .io import native, storage
+
+
+def compression_options(settings, influences_available):
+    """sp_compress_options from plain settings (options_summary() of the mesh settings, or the
+    settings themselves); raises ValueError for an unreachable error target."""
+    method, budget = settings["method"], settings["budget"]
+    K = min(settings["max_influences"], influences_available)
+    if budget == 'ERROR':
+        bits = native.weight_bits_for_error(method, K, settings["max_error"])
+        if bits is None:
+            raise ValueError("no %s configuration reaches a max error of %g" % (method, settings["max_error"]))
+        return native.make_options(method, settings["max_influences"], weight_bits=bits)
+    bits = settings["custom_bits"] if budget == 'CUSTOM' else int(budget)
+    return native.make_options(method, settings["max_influences"], vertex_bits=bits)
+
+
+def budget_text(settings):
+    if settings["budget"] == 'ERROR':
+        return "max error %g" % settings["max_error"]
+    bits = settings["custom_bits"] if settings["budget"] == 'CUSTOM' else int(settings["budget"])
+    return "%d bits per vertex for tuple index and weights" % bits
+
+
+def compress_skin(name, joints, weights, joint_count, settings):
+    """native.compress with the options of settings; errors name `name` and the vertex or budget."""
+    try:
+        options = compression_options(settings, weights.shape[1])
+        return native.compress(joints, weights, joint_count, options)
+    except native.SkinpackError as error:
+        if error.code in native.PER_VERTEX_ERRORS:
+            detail = " (vertex %d)" % error.vertex
+        else:
+            detail = " (%s, %s)" % (settings["method"], budget_text(settings))
+        raise native.SkinpackError("%s: %s%s" % (name, error, detail), error.code, error.vertex)
+    except ValueError as error:
+        raise ValueError("%s: %s" % (name, error))
+
+
+def compress_object(obj):
+    """Reads, compresses and stores; returns the stored result."""
+    skin = gather.gather(obj)
+    settings = obj.data.skinpack.options_summary()
+    compressed = compress_skin(obj.name, skin.joints, skin.weights, len(skin.joint_names), settings)
+    return storage.save_result(obj.data, compressed, skin, settings)
+
+
+def size_text(stats):
+    """Bits a vertex before and after; a skin with one joint tuple stores no per-vertex data,
+    and a ratio against its table alone would mean nothing."""
+    if stats["tuple_bits"] + stats["weight_bits"] == 0:
+        return "%.1f -> 0 bits/vertex (one joint tuple: only the %d-entry table is stored)" % (
+            stats["input_bits_per_vertex"], stats["unique_tuples"])
+    return "%.1f -> %.1f bits/vertex (%.1fx)" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"],
+                                                stats["ratio"])
+
+
+def pruning_text(stats):
+    """'' when no vertex lost an influence, else how many, from how many, and the weight change."""
+    if not stats["pruned_vertices"]:
+        return ""
+    most = "%d%s" % (stats["max_input_influences"], " or more" if stats["max_input_influences_capped"] else "")
+    return ("%d vertices pruned to %d influences (up to %s before), max weight change %.3f"
+            % (stats["pruned_vertices"], stats["influences"], most, stats["max_pruning_error"]))
+
+
+def stats_line(stats):
+    line = "%s: %s, %d tuples, max error %.2e, RMS %.2e" % (
+        stats["method"].upper(), size_text(stats), stats["unique_tuples"], stats["max_error"], stats["rms_error"])
+    pruning = pruning_text(stats)
+    return line + "; " + pruning if pruning else line
+
+
+def show_decoded(obj):
+    mesh = obj.data
+    result = storage.load_result(mesh)
+    if result is None or storage.is_stale(mesh, result):
+        raise preview.PreviewError("%s: no up-to-date compression result; press Compress first" % obj.name)
+    skin = gather.gather(obj)
+    if not storage.matches_weights(result, skin):
+        raise preview.PreviewError("%s: the weights or deform bones changed since compression; compress again"
+                                   % obj.name)
+    decoded_joints, decoded_weights = result.decode()
+    decoded = gather.decoded_element_weights(skin, decoded_joints, decoded_weights)
+    storage.save_originals(mesh, skin.element_counts, skin.element_groups, skin.element_weights)
+    try:
+        gather.write_element_weights(mesh, skin.element_counts, decoded, skin.element_weights)
+    except Exception:
+        # Whatever was written so far goes back; unchanged elements are skipped.
+        _, _, partial = gather.read_elements(mesh)
+        gather.write_element_weights(mesh, skin.element_counts, skin.element_weights, partial)
+        storage.clear_originals(mesh)
+        raise
+
+
+def restore_originals(obj):
+    mesh = obj.data
+    counts, groups, weights = storage.load_originals(mesh)
+    current_counts, current_groups, current_weights = gather.read_elements(mesh)
+    if not (len(counts) == len(current_counts) and (counts == current_counts).all()
+            and (groups == current_groups).all()):
+        raise preview.PreviewError("%s: vertices or group memberships changed while the decoded weights were "
+                                   "shown; originals kept in the mesh's '%s' property" % (obj.name, storage.ORIGINAL_KEY))
+    gather.write_element_weights(mesh, counts, weights, current_weights)
+    storage.clear_originals(mesh)
