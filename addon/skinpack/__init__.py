@@ -25,6 +25,14 @@ bl_info = {
     "category": "Import-Export",
 }
 
+import sys  # noqa: E402
+
+# Re-enabling after an update re-runs this file in the same module: drop the old submodules so
+# that the imports below load the new files (and the new library copy), not a mix of versions.
+if "bpy" in locals():
+    for _name in [name for name in sys.modules if name.startswith(__name__ + ".")]:
+        del sys.modules[_name]
+
 import bpy  # noqa: E402
 
 from . import operators, panel, properties  # noqa: E402

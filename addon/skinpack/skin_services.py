@@ -31,11 +31,18 @@ def budget_text(settings):
     return "%d bits per vertex for tuple index and weights" % bits
 
 
+def most_influences(weights):
+    """The most non-zero weights of any vertex (for the pruning message)."""
+    return int((weights > 0).sum(axis=1).max()) if len(weights) else 0
+
+
 def compress_skin(name, joints, weights, joint_count, settings):
-    """native.compress with the options of settings; errors name `name` and the vertex or budget."""
+    """(native.Compressed, stats dict) with the options of settings; errors name `name` and the
+    vertex or budget."""
     try:
         options = compression_options(settings, weights.shape[1])
-        return native.compress(joints, weights, joint_count, options)
+        compressed = native.compress(joints, weights, joint_count, options)
+        return compressed, native.stats_dict(compressed, most_influences(weights))
     except native.SkinpackError as error:
         if error.code in native.PER_VERTEX_ERRORS:
             detail = " (vertex %d)" % error.vertex
@@ -50,8 +57,8 @@ def compress_object(obj):
     """Reads, compresses and stores; returns the stored result."""
     skin = gather.gather(obj)
     settings = obj.data.skinpack.options_summary()
-    compressed = compress_skin(obj.name, skin.joints, skin.weights, len(skin.joint_names), settings)
-    return storage.save_result(obj.data, compressed, skin, settings)
+    compressed, stats = compress_skin(obj.name, skin.joints, skin.weights, len(skin.joint_names), settings)
+    return storage.save_result(obj.data, compressed, stats, skin, settings)
 
 
 def size_text(stats):

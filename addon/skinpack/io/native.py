@@ -347,14 +347,18 @@ def decompress(method, influences, n, axis_samples, words, vertex_count, tuple_b
     return joints, weights
 
 
-def stats_dict(compressed):
+def stats_dict(compressed, max_input_influences=None):
     """The numbers the panel, the CLI comparison and the export report show. The "before" size is
     what glTF stores for the same skin uncompressed: JOINTS_0 (u8, or u16 above 256 joints) and
-    WEIGHTS_0 (float), VEC4 each."""
+    WEIGHTS_0 (float), VEC4 each. max_input_influences: the most non-zero influences of a vertex
+    when the caller counted them (the library's histogram stops at SP_MAX_INPUT_INFLUENCES)."""
     s = compressed.skin
     input_bits_per_vertex = 4 * (8 * s.joint_bytes + 32)
     histogram = list(s.prepare.influence_histogram)
     most_influences = max((n for n, count in enumerate(histogram) if count), default=0)
+    capped = most_influences == SP_MAX_INPUT_INFLUENCES  # the histogram's last bin: this many or more
+    if max_input_influences is not None:  # counted by the caller, who has the input
+        most_influences, capped = int(max_input_influences), False
     return {
         "vertices": int(s.vertex_count),
         "joint_count": int(s.joint_count),
@@ -375,7 +379,7 @@ def stats_dict(compressed):
         "error_bound": float(s.codec.max_error),
         "pruned_vertices": int(s.prepare.pruned_vertices),
         "max_input_influences": most_influences,
-        "max_input_influences_capped": most_influences == SP_MAX_INPUT_INFLUENCES,
+        "max_input_influences_capped": capped,
         "max_pruning_error": float(s.prepare.max_pruning_error),
         "renormalized_vertices": int(s.prepare.renormalized_vertices),
     }

@@ -40,9 +40,9 @@ class StoredResult:
                                  info["joint_count"])
 
 
-def save_result(mesh, compressed, skin_weights, settings_summary):
-    stats = native.stats_dict(compressed)
-    stats["ignored_groups"] = len(skin_weights.ignored_groups)
+def save_result(mesh, compressed, stats, skin_weights, settings_summary):
+    """Stores a native.Compressed skin, its stats (native.stats_dict) and what it was made from."""
+    stats = dict(stats, ignored_groups=len(skin_weights.ignored_groups))
     info = {
         "version": FORMAT_VERSION,
         "method": compressed.method,

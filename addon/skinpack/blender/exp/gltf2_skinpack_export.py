@@ -213,15 +213,15 @@ class glTF2ExportUserExtension:
                 return
             joints, weights = arrays
             try:
-                compressed = skin_services.compress_skin(source.object_name, joints, weights, joint_count,
-                                                         source.settings)
+                compressed, stats = skin_services.compress_skin(source.object_name, joints, weights,
+                                                                joint_count, source.settings)
             except (native.SkinpackError, ValueError) as error:
                 self._fail(export_settings, "%s; primitive left uncompressed" % error)
                 return
             Extension = gltf_api.extension_class()
             self.done[cache_key] = Extension(ext.EXTENSION_NAME, extension_json(compressed, joint_count),
                                              required=self.compact)
-            last_report.compressed.append((source.object_name, native.stats_dict(compressed)))
+            last_report.compressed.append((source.object_name, stats))
             if self.compact:
                 self._drop_plain_skin(primitive, joint_count, len(joints))
         if primitive.extensions is None:
@@ -248,8 +248,7 @@ def pre_export(export_settings):
     """glTF2_pre_export_callback: previews off the meshes; Draco refused when Skinpack is on."""
     extension = _our_extension(export_settings)
     if extension is not None and extension.enabled and export_settings.get("gltf_draco_mesh_compression"):
-        message = ("Draco mesh compression reorders the vertices after Skinpack reads them; turn off "
-                   "either Draco or Skinpack in the exporter's options (nothing was written)")
+        message = "Draco reorders vertices: turn off Draco or Skinpack (nothing written)"
         extension._fail(export_settings, message)
         raise ExportRefused("Skinpack: " + message)
     _detached_previews.extend(preview.detach_previews(bpy.data.meshes))
