@@ -187,7 +187,9 @@ static void valid_primitives(void)
     for (size_t influences = 1; influences <= 4; ++influences) {
         make_mesh(influences);
         for (int m = 0; m < SP_METHOD_COUNT; ++m)
-            for (uint32_t bits = 16; bits <= 64; bits += 16) {
+            for (uint32_t b = 0; b < 5; ++b) { /* 12: the Any w1 < 0 regression at small vertex budgets */
+                static const uint32_t budgets[5] = {10, 12, 16, 32, 64};
+                uint32_t bits = budgets[b];
                 sp_compress_options o;
                 sp_compress_options_default(&o);
                 o.method = (sp_method)m;
