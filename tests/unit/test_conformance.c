@@ -11,73 +11,10 @@
 
 #include "check.h"
 #include "conformance_common.h"
-
-/* The value after "key": in a flat JSON line; strings are returned without their quotes. */
-static const char* field(const char* line, const char* key)
-{
-    char pattern[64];
-    snprintf(pattern, sizeof(pattern), "\"%s\": ", key);
-    const char* at = strstr(line, pattern);
-    return at ? at + strlen(pattern) : NULL;
-}
-
-static uint64_t quoted_u64(const char** at)
-{
-    while (**at && **at != '"') ++*at;
-    ++*at;
-    uint64_t v = strtoull(*at, (char**)at, 10);
-    ++*at; /* closing quote */
-    return v;
-}
-
-/* Up to max entries of a ["..", ".."] array of quoted integers (hex when base is 16). */
-static size_t quoted_array(const char* at, uint64_t* out, size_t max, int base)
-{
-    size_t count = 0;
-    if (!at || *at != '[') return 0;
-    ++at;
-    while (*at && *at != ']' && count < max) {
-        if (*at == '"') {
-            ++at;
-            out[count++] = strtoull(at, (char**)&at, base);
-        }
-        ++at;
-    }
-    return count;
-}
-
-typedef struct vector {
-    sp_method method;
-    uint32_t k, weight_bits;
-    uint64_t n, axes[3], max_code, scale, code, grid[4], weights[4];
-    size_t axis_count, grid_count, weight_count;
-    int valid;
-    char reason[32];
-} vector;
-
-static int parse(const char* line, vector* v)
-{
-    const char* at = field(line, "method");
-    char name[16] = {0};
-    if (!at || sscanf(at, "\"%15[a-z]\"", name) != 1) return -1;
-    v->method = sp_method_from_name(name);
-    v->k = (uint32_t)strtoul(field(line, "influences"), NULL, 10);
-    at = field(line, "n"), v->n = quoted_u64(&at);
-    v->axis_count = quoted_array(field(line, "axisSamples"), v->axes, 3, 10);
-    v->weight_bits = (uint32_t)strtoul(field(line, "weightBits"), NULL, 10);
-    at = field(line, "maxCode"), v->max_code = quoted_u64(&at);
-    at = field(line, "scale"), v->scale = quoted_u64(&at);
-    at = field(line, "code"), v->code = quoted_u64(&at);
-    v->valid = strncmp(field(line, "valid"), "true", 4) == 0;
-    v->grid_count = quoted_array(field(line, "grid"), v->grid, 4, 10);
-    v->weight_count = quoted_array(field(line, "weights"), v->weights, 4, 16);
-    at = field(line, "reason");
-    if (at) sscanf(at, "\"%31[^\"]\"", v->reason);
-    return v->method < SP_METHOD_COUNT ? 0 : -1;
-}
+#include "conformance_vectors.h"
 
 /* A one-vertex primitive holding the code, validated by the library's reader entry point. */
-static sp_result validate_one(const vector* v, const sp_codec* codec, float* weights)
+static sp_result validate_one(const conformance_vector* v, const sp_codec* codec, float* weights)
 {
     static const uint16_t lut[4] = {0, 1, 2, 3};
     uint32_t words[2] = {(uint32_t)v->code, (uint32_t)(v->code >> 32)};
@@ -89,7 +26,7 @@ static sp_result validate_one(const vector* v, const sp_codec* codec, float* wei
     return sp_validate_packed(&prim, joints, weights, NULL);
 }
 
-static void check_vector(const vector* v, size_t line)
+static void check_vector(const conformance_vector* v, size_t line)
 {
     sp_codec codec;
     CHECK_MSG(sp_codec_from_params(v->method, v->k, v->n, v->axis_count ? v->axes : NULL, &codec) == SP_OK, "line %zu",
@@ -121,7 +58,7 @@ static void check_vector(const vector* v, size_t line)
 }
 
 /* All valid codes of one codec decoded in one batch (repeated to fill vector blocks). */
-static void check_batch(const vector* group, size_t count, size_t first_line)
+static void check_batch(const conformance_vector* group, size_t count, size_t first_line)
 {
     enum { COPIES = 8 };
     uint64_t codes[64 * COPIES];
@@ -137,7 +74,7 @@ static void check_batch(const vector* group, size_t count, size_t first_line)
     size_t bad = 0;
     CHECK_MSG(sp_decode_weights_batch(&codec, codes, n, weights, &bad) == SP_OK, "batch at line %zu", first_line);
     for (size_t i = 0, at = 0; i < n; ++at) {
-        const vector* v = &group[at % count];
+        const conformance_vector* v = &group[at % count];
         if (!v->valid) continue;
         for (uint32_t s = 0; s < v->k; ++s) {
             uint32_t bits;
@@ -155,16 +92,16 @@ int main(int argc, char** argv)
         fprintf(stderr, "usage: test_conformance weights.jsonl\n");
         return 2;
     }
-    static vector group[64];
+    static conformance_vector group[64];
     static char line[4096];
     size_t lines = 0, in_group = 0, group_line = 0, valid = 0, invalid = 0;
     uint32_t methods_seen = 0, widths64 = 0;
     char key[256] = "", previous[256] = "";
     while (fgets(line, sizeof(line), f)) {
-        vector v;
+        conformance_vector v;
         memset(&v, 0, sizeof(v));
         ++lines;
-        CHECK_MSG(parse(line, &v) == 0, "line %zu does not parse", lines);
+        CHECK_MSG(conformance_parse(line, &v) == 0, "line %zu does not parse", lines);
         check_vector(&v, lines);
         v.valid ? ++valid : ++invalid;
         methods_seen |= 1u << v.method;
