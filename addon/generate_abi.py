@@ -54,6 +54,7 @@ def _parse_struct(name, body, known_types, constants):
     for declaration in (part.strip() for part in body.split(";")):
         if not declaration:
             continue
+        declaration = re.sub(r"^const\s+", "", declaration)  # const T* reads the same as T*
         match = re.match(r"^(\w+)((?:\s|\*).*)$", declaration, re.S)
         if match is None:
             raise HeaderError("%s: cannot read the field %r" % (name, declaration))
@@ -107,7 +108,37 @@ def abi_module_source(header_text, header_name="skinpack.h"):
     return "\n".join(lines)
 
 
+def layout_program_source(header_text, header_name="skinpack.h"):
+    """C source that prints sizeof/offsetof of every struct and field as JSON, as the compiler
+    lays them out: tests/blender/test_native_layout.py compares them with the ctypes mirrors."""
+    _, _, structs, _ = parse_header(header_text)
+    lines = ["/* Generated from %s by addon/generate_abi.py: do not edit. */" % header_name,
+             "#include <stddef.h>", "#include <stdio.h>", "", '#include "%s"' % header_name, "",
+             "int main(void)", "{", '    printf("{");']
+    for number, (name, fields) in enumerate(structs.items()):
+        lines.append('    printf("%s\\"%s\\": {\\"size\\": %%zu, \\"fields\\": {", sizeof(%s));'
+                     % (", " if number else "", name, name))
+        for index, field in enumerate(fields):
+            lines.append('    printf("%s\\"%s\\": %%zu", offsetof(%s, %s));'
+                         % (", " if index else "", field[0], name, field[0]))
+        lines.append('    printf("}}");')
+    lines += ['    printf("}\\n");', "    return 0;", "}", ""]
+    return "\n".join(lines)
+
+
+def main():
+    import argparse
+    parser = argparse.ArgumentParser(description="skinpack.h -> _abi.py (default) or the layout program")
+    parser.add_argument("header")
+    parser.add_argument("--layout-c", action="store_true", help="write the C layout program instead")
+    parser.add_argument("--output", required=True)
+    args = parser.parse_args()
+    with open(args.header, encoding="utf-8") as handle:
+        text = handle.read()
+    source = layout_program_source(text) if args.layout_c else abi_module_source(text)
+    with open(args.output, "w", encoding="utf-8") as handle:
+        handle.write(source)
+
+
 if __name__ == "__main__":
-    import sys
-    with open(sys.argv[1], encoding="utf-8") as handle:
-        sys.stdout.write(abi_module_source(handle.read()))
+    main()

@@ -65,7 +65,25 @@ class SKINPACK_PT_skin(bpy.types.Panel):
             col.operator("skinpack.export_gltf", icon='EXPORT')
         elif storage.showing_decoded(mesh):
             layout.operator("skinpack.toggle_decoded", text="Restore Original Weights", icon='LOOP_BACK')
+        _draw_last_export(layout)
         _draw_meshlets(layout, context, obj)
+
+
+def _draw_last_export(layout):
+    """What the latest glTF export of this session compressed, pruned and left out, by object
+    name: Blender 3.x has no export log to show it, and the console is not where users look."""
+    from .blender.exp import gltf2_skinpack_export as exporter
+    report = exporter.last_report
+    if not report.compressed and not report.errors:
+        return
+    box = layout.box()
+    box.label(text="Last glTF export: " + report.summary(), icon='EXPORT')
+    for warning in report.warnings():
+        for line in _wrap(warning, 70):
+            box.label(text=line, icon='INFO')
+    for error in report.errors:
+        for line in _wrap(error, 70):
+            box.label(text=line, icon='ERROR')
 
 
 def _draw_stats(layout, mesh, result):

@@ -10,16 +10,11 @@ from . import gather, preview
 from .io import native, storage
 
 
-def compression_options(settings, influences_available):
-    """sp_compress_options from plain settings (options_summary() of the mesh settings, or the
-    settings themselves); raises ValueError for an unreachable error target."""
+def compression_options(settings):
+    """sp_compress_options from plain settings (options_summary() of the mesh settings)."""
     method, budget = settings["method"], settings["budget"]
-    K = min(settings["max_influences"], influences_available)
-    if budget == 'ERROR':
-        bits = native.weight_bits_for_error(method, K, settings["max_error"])
-        if bits is None:
-            raise ValueError("no %s configuration reaches a max error of %g" % (method, settings["max_error"]))
-        return native.make_options(method, settings["max_influences"], weight_bits=bits)
+    if budget == 'ERROR':  # the library finds the fewest weight bits for the K it uses
+        return native.make_options(method, settings["max_influences"], max_error=settings["max_error"])
     bits = settings["custom_bits"] if budget == 'CUSTOM' else int(budget)
     return native.make_options(method, settings["max_influences"], vertex_bits=bits)
 
@@ -40,7 +35,7 @@ def compress_skin(name, joints, weights, joint_count, settings):
     """(native.Compressed, stats dict) with the options of settings; errors name `name` and the
     vertex or budget."""
     try:
-        options = compression_options(settings, weights.shape[1])
+        options = compression_options(settings)
         compressed = native.compress(joints, weights, joint_count, options)
         return compressed, native.stats_dict(compressed, most_influences(weights))
     except native.SkinpackError as error:

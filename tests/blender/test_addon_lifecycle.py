@@ -35,6 +35,7 @@ def main():
     args = common.arguments()
     common.install_addon(args.zip)
     from skinpack import operators, panel, properties
+    from skinpack.io import storage
     CLASSES.extend(properties.classes + operators.classes + panel.classes)
     common.check(set(registered_names()) >= set(TYPES) | {c.__name__ for c in CLASSES},
                  "not registered: %s" % registered_names())
@@ -56,10 +57,19 @@ def main():
     texts = common.draw_skinpack_panel(obj)
     common.check(any(t.startswith("Weight error") for t in texts) and any(t.startswith("Values ") for t in texts),
                  "panel without heat-map legend: %s" % texts)
+    # One tick per swatch, in the swatches' columns: 0, scale/4, ..., >= scale (red labelled).
+    from skinpack import preview
+    scale = obj.data[storage.PREVIEW_KEY]["scale"]
+    ticks = panel.ramp_ticks(scale, "%.2e")
+    common.check(len(ticks) == len(preview.RAMP) and ticks[0] == "0" and ticks[-1] == "\u2265 %.2e" % scale
+                 and ticks[2] == "%.2e" % (scale / 2), "legend ticks %s for scale %g" % (ticks, scale))
+    common.check(any(texts[at:at + len(ticks)] == ticks for at in range(len(texts))),
+                 "panel legend ticks %s not in %s" % (ticks, texts))
 
     # The glTF exporter's hooks are found on the top-level module.
     module = sys.modules["skinpack"]
-    for name in ("glTF2ExportUserExtension", "glTF2ImportUserExtension", "register_panel"):
+    for name in ("glTF2ExportUserExtension", "glTF2ImportUserExtension", "register_panel",
+                 "glTF2_pre_export_callback", "glTF2_post_export_callback"):
         common.check(hasattr(module, name), "skinpack.%s missing (the glTF add-on looks it up)" % name)
     unregister = module.register_panel()
     common.check(hasattr(bpy.types, "SKINPACK_PT_gltf_export"), "exporter panel not registered")

@@ -46,7 +46,7 @@ def check_heat_map(obj, result):
     from skinpack import gather, preview, skin_services
     from skinpack.io import native
     skin = gather.gather(obj)
-    options = skin_services.compression_options(obj.data.skinpack.options_summary(), skin.weights.shape[1])
+    options = skin_services.compression_options(obj.data.skinpack.options_summary())
     fresh = native.compress(skin.joints, skin.weights, len(skin.joint_names), options)
     common.check(np.array_equal(fresh.per_vertex_error, result.per_vertex_error),
                  "%s: stored per-vertex errors differ from the library's" % obj.name)

@@ -80,6 +80,10 @@ def check_export(args, obj, mode):
     warnings = exporter.last_report.warnings()
     common.check(any(w.startswith(obj.name + ": ") and "pruned to 4 influences" in w for w in warnings),
                  "%s %s: pruning not reported by object name: %s" % (obj.name, mode, warnings))
+    texts = common.draw_skinpack_panel(obj)
+    common.check(any(t.startswith("Last glTF export: 1 skinned primitives compressed") and obj.name in t for t in texts)
+                 and any(t.startswith(obj.name + ": ") and "pruned" in t for t in texts),
+                 "%s: the panel does not show the export's pruning: %s" % (obj.name, texts))
 
     plain_path = os.path.join(args.out, "%s_plain.glb" % obj.name)
     obj.find_armature().select_set(True)

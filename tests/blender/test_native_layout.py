@@ -1,7 +1,8 @@
 """The ctypes mirror of skinpack.h matches the C layout, and the binding round-trips a skin.
 
-The C side is printed by skinpack_struct_layout (sizeof/offsetof as the compiler sees them);
-any drift in field order, type or count fails here before it can corrupt a call.
+The C side is printed by skinpack_struct_layout (sizeof/offsetof as the compiler sees them, a
+program generated from skinpack.h); the ctypes side is built from the add-on's generated
+_abi.py. Any drift in field order, type or count fails here before it can corrupt a call.
 """
 
 import ctypes
@@ -34,6 +35,18 @@ def main():
             offset = getattr(mirror, name).offset
             common.check(offset == c_struct["fields"][name], "%s.%s: ctypes offset %d, C offset %d"
                          % (c_name, name, offset, c_struct["fields"][name]))
+
+    # The load-time ABI check: the mirrors' sizes pass, one wrong size is refused by the library.
+    sizes = native._struct_sizes()
+    lib = native.load()
+    bad = ctypes.c_uint32(0)
+    common.check(lib.sp_check_abi(native.SP_VERSION, (ctypes.c_size_t * len(sizes))(*sizes), len(sizes),
+                                  ctypes.byref(bad)) == native.SP_OK, "sp_check_abi refuses the mirrors")
+    sizes[1] += 8
+    common.check(lib.sp_check_abi(native.SP_VERSION, (ctypes.c_size_t * len(sizes))(*sizes), len(sizes),
+                                  ctypes.byref(bad)) != native.SP_OK and bad.value == 1, "a wrong size passed")
+    common.check(lib.sp_check_abi(native.SP_VERSION + 1, None, 0, ctypes.byref(bad)) != native.SP_OK,
+                 "another version passed")
 
     # Defaults come from the library, not from Python.
     options = native.default_options()

@@ -183,16 +183,27 @@ def _private_copy(path):
     return target
 
 
-def _check_version(lib, path):
-    """The library's own version against the header the mirrors were generated from."""
-    if not hasattr(lib, "sp_version"):
-        return
+def _struct_sizes():
+    """ctypes sizes of the mirrors in sp_struct_id order (SP_STRUCT_CODEC -> sp_codec, ...)."""
+    ids = sorted((value, name) for name, value in _abi.ENUMS["sp_struct_id"].items() if name != "SP_STRUCT_COUNT")
+    return [ctypes.sizeof(MIRRORED_STRUCTS["sp_" + name[len("SP_STRUCT_"):].lower()]) for _, name in ids]
+
+
+def _check_abi(lib, path):
+    """sp_check_abi: the library's version and struct sizes against the header the mirrors were
+    generated from (a library from another build must not be called with these layouts)."""
+    sizes = _struct_sizes()
+    lib.sp_check_abi.restype = ctypes.c_int
+    lib.sp_check_abi.argtypes = [ctypes.c_uint32, ctypes.POINTER(ctypes.c_size_t), ctypes.c_size_t,
+                                 ctypes.POINTER(ctypes.c_uint32)]
     lib.sp_version.restype = ctypes.c_uint32
     lib.sp_version.argtypes = []
-    version = lib.sp_version()
-    if version != SP_VERSION:
-        raise OSError("%s is version %d, the add-on was built for %d; reinstall the add-on zip"
-                      % (path, version, SP_VERSION))
+    bad = ctypes.c_uint32(0)
+    code = lib.sp_check_abi(SP_VERSION, (ctypes.c_size_t * len(sizes))(*sizes), len(sizes), ctypes.byref(bad))
+    if code != SP_OK:
+        names = {value: name for name, value in _abi.ENUMS["sp_struct_id"].items()}
+        raise OSError("%s (version %d) does not match the add-on's skinpack.h (version %d, %s); reinstall the "
+                      "add-on zip" % (path, lib.sp_version(), SP_VERSION, names.get(bad.value, "?")))
 
 
 def load():
@@ -204,7 +215,7 @@ def load():
     try:
         loaded_from = _private_copy(path)
         lib = ctypes.CDLL(loaded_from)
-        _check_version(lib, path)
+        _check_abi(lib, path)
         _declare(lib)
     except (OSError, AttributeError) as error:
         _load_error = "Cannot load %s: %s" % (path, error)
@@ -241,15 +252,16 @@ def default_options():
     return options
 
 
-def make_options(method, max_influences, vertex_bits=0, weight_bits=0, max_spacing=0.0):
+def make_options(method, max_influences, vertex_bits=0, weight_bits=0, max_spacing=0.0, max_error=0.0):
     """The library's default options with the method, K and exactly one budget set
-    (vertex_bits, weight_bits or max_spacing)."""
+    (vertex_bits, weight_bits, max_spacing or max_error: the library searches the bits)."""
     options = default_options()
     options.method = METHODS.index(method)
     options.max_influences = max_influences
     options.vertex_bits = vertex_bits
     options.weight_bits = weight_bits
     options.max_spacing = max_spacing
+    options.max_error = max_error
     return options
 
 
@@ -312,19 +324,6 @@ def codec_from_params(method, influences, n, axis_samples=None):
     if code != SP_OK:
         raise SkinpackError("invalid codec parameters (%s): %s" % (method, result_string(code)), code)
     return codec
-
-
-def weight_bits_for_error(method, influences, max_error):
-    """The fewest weight-code bits whose proven bound (sp_codec.max_error) is <= max_error,
-    or None if even 64 bits do not reach it."""
-    lib = _require()
-    codec = Codec()
-    for bits in range(0, 65):
-        if lib.sp_codec_from_bits(METHODS.index(method), influences, bits, ctypes.byref(codec)) != SP_OK:
-            continue
-        if codec.max_error <= max_error:
-            return bits
-    return None
 
 
 def decompress(method, influences, n, axis_samples, words, vertex_count, tuple_bits, lut, joint_count):
