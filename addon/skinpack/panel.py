@@ -112,25 +112,13 @@ def _draw_stats(layout, mesh, result):
         box.label(text=pruning, icon='INFO')
 
 
-def ramp_ticks(scale, number_format):
-    """One label per ramp swatch: the value at which the ramp reaches that swatch's colour
-    (0, scale/4, ..., scale); the last swatch also stands for everything above the scale."""
-    steps = len(preview.RAMP) - 1
-    labels = []
-    for index in range(len(preview.RAMP)):
-        value = scale * index / steps
-        labels.append(number_format % value if value else "0")
-    labels[-1] = "\u2265 " + labels[-1]
-    return labels
-
-
 def _draw_ramp(box, context, scale, number_format):
     """The heat-map colour ramp as swatches, each with its value right under it (same columns)."""
     legend = context.window_manager.skinpack_legend
     grid = box.grid_flow(row_major=True, columns=len(preview.RAMP), even_columns=True, align=True)
     for index in range(len(preview.RAMP)):
         grid.prop(legend, "color_%d" % index, text="")
-    for label in ramp_ticks(scale, number_format):
+    for label in preview.ramp_ticks(scale, number_format):
         grid.label(text=label)
 
 

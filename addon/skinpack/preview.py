@@ -54,6 +54,16 @@ def mode_label(info):
     return MODE_LABELS[info["mode"]]
 
 
+def ramp_ticks(scale, number_format):
+    """One label per ramp colour: the value at which the ramp reaches it (0, scale/4, ...,
+    scale); the last colour also stands for everything above the scale. The panel's legend and
+    the rendered pictures' legend both use these."""
+    steps = len(RAMP) - 1
+    labels = [number_format % (scale * index / steps) if index else "0" for index in range(len(RAMP))]
+    labels[-1] = "\u2265 " + labels[-1]
+    return labels
+
+
 class PreviewError(Exception):
     pass
 

@@ -60,7 +60,7 @@ def main():
     # One tick per swatch, in the swatches' columns: 0, scale/4, ..., >= scale (red labelled).
     from skinpack import preview
     scale = obj.data[storage.PREVIEW_KEY]["scale"]
-    ticks = panel.ramp_ticks(scale, "%.2e")
+    ticks = preview.ramp_ticks(scale, "%.2e")
     common.check(len(ticks) == len(preview.RAMP) and ticks[0] == "0" and ticks[-1] == "\u2265 %.2e" % scale
                  and ticks[2] == "%.2e" % (scale / 2), "legend ticks %s for scale %g" % (ticks, scale))
     common.check(any(texts[at:at + len(ticks)] == ticks for at in range(len(texts))),
