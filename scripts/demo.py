@@ -182,7 +182,8 @@ def main():
         bpy.ops.skinpack.preview_error(mode=mode)
         legend = body.data[storage.PREVIEW_KEY]
         path = os.path.join(args.out, "heatmap_%s.png" % mode.lower())
-        skinpack_render.render_workbench(path, body, resolution=(640, 720))
+        skinpack_render.render_workbench(path, body, resolution=(640, 720),
+                                         legend=skinpack_render.heat_map_legend(body))
         pictures.append((path, legend["maximum"], legend["scale"]))
     bpy.ops.skinpack.clear_preview()
     bpy.ops.wm.save_as_mainfile(filepath=blend_path)

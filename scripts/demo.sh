@@ -15,7 +15,7 @@ mkdir -p "$OUT"
 # A scratch Blender user folder: the demo installs the add-on there, never into ~/.config.
 SCRATCH=$(mktemp -d)
 trap 'rm -rf "$SCRATCH"' EXIT
-export BLENDER_USER_SCRIPTS=$SCRATCH/scripts BLENDER_USER_CONFIG=$SCRATCH/config
+export BLENDER_USER_SCRIPTS=$SCRATCH/scripts BLENDER_USER_CONFIG=$SCRATCH/config BLENDER_USER_DATAFILES=$SCRATCH/datafiles
 blender -b --factory-startup --python-exit-code 1 --python scripts/demo.py -- \
   --zip "$ZIP" --out "$OUT" --validator tools/validate.mjs --cli "$BUILD/native/cli/skinpack" \
   2>&1 | grep -v -e "^$" -e "| INFO:" -e "Draco mesh compression" -e "EGL Error"

@@ -35,9 +35,22 @@ if "bpy" in locals():
 
 import bpy  # noqa: E402
 
+from .io import native  # noqa: E402
+
+
+def library_cache_dir():
+    """A folder no add-on install or update writes to, for native.py's private library copy."""
+    extension_path_user = getattr(bpy.utils, "extension_path_user", None)
+    if extension_path_user is not None and __package__.startswith("bl_ext."):
+        return extension_path_user(__package__, path="library", create=True)  # Blender 4.2+ Extension
+    return bpy.utils.user_resource('DATAFILES', path="skinpack", create=True)
+
+
+# Before the modules below: properties.py asks the library for its defaults when imported.
+native.set_cache_dir(library_cache_dir())
+
 from . import operators, panel, properties  # noqa: E402
 from .blender.exp import gltf2_skinpack_export  # noqa: E402
-from .io import native  # noqa: E402
 
 # The glTF add-on looks these names up on every enabled add-on's top-level module.
 from .blender.exp.gltf2_skinpack_export import glTF2ExportUserExtension, register_panel  # noqa: E402,F401
@@ -52,20 +65,11 @@ def glTF2_post_export_callback(export_settings):
     gltf2_skinpack_export.post_export(export_settings)
 
 
-def library_cache_dir():
-    """A folder no add-on install or update writes to, for native.py's private library copy."""
-    extension_path_user = getattr(bpy.utils, "extension_path_user", None)
-    if extension_path_user is not None and __package__.startswith("bl_ext."):
-        return extension_path_user(__package__, path="library", create=True)  # Blender 4.2+ Extension
-    return bpy.utils.user_resource('DATAFILES', path="skinpack", create=True)
-
-
 def menu_func_export(self, context):
     self.layout.operator(operators.SKINPACK_OT_export_gltf.bl_idname, text="Skinpack Compressed glTF (.glb)")
 
 
 def register():
-    native.set_cache_dir(library_cache_dir())
     properties.register()
     operators.register()
     panel.register()

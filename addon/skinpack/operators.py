@@ -9,7 +9,7 @@ import os
 import time
 
 import bpy
-from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy.props import EnumProperty, StringProperty
 
 from . import gather, meshlet_preview, preview, properties, skin_services
 from .io import native, storage
@@ -133,11 +133,10 @@ class SKINPACK_OT_preview_meshlets(bpy.types.Operator):
     bl_options = {'REGISTER', 'UNDO'}
 
     mode: EnumProperty(name="Mode", default='MESHLET', items=properties.MESHLET_MODE_ITEMS)
-    builder: EnumProperty(name="Builder", default='SKIN', items=properties.MESHLET_BUILDER_ITEMS)
-    max_vertices: IntProperty(name="Max Vertices", default=64, min=3, max=255)
-    max_triangles: IntProperty(name="Max Triangles", default=124, min=1, max=512)
-    palette_size: IntProperty(name="Palette Size", default=32, min=1, max=255,
-                              description="Distinct joints per meshlet")
+    builder: EnumProperty(name="Builder", default=properties.DEFAULTS["builder"], items=properties.MESHLET_BUILDER_ITEMS)
+    max_vertices: properties.meshlet_limit_properties()["max_vertices"]
+    max_triangles: properties.meshlet_limit_properties()["max_triangles"]
+    palette_size: properties.meshlet_limit_properties()["palette_size"]
 
     @classmethod
     def poll(cls, context):

@@ -5,6 +5,46 @@ from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorPro
                        StringProperty)
 
 from . import preview
+from .io import native
+
+
+def _library_defaults():
+    """Defaults and limits of the settings, from the library (sp_compress_options_default,
+    sp_meshlet_options_default, skinpack.h's limits), never copied here. Without a loadable
+    library the limits stand in (the panel then only shows why the library did not load)."""
+    limits = native.CONSTANTS
+    defaults = {"method": 'OSS', "budget": '32', "max_influences": limits["SP_MAX_INFLUENCES"],
+                "builder": 'SKIN', "max_vertices": limits["SP_MESHLET_MAX_VERTICES"],
+                "max_triangles": limits["SP_MESHLET_MAX_TRIANGLES"], "palette_size": limits["SP_MESHLET_MAX_JOINTS"]}
+    try:
+        options, meshlets = native.default_options(), native.meshlet_options()
+    except native.SkinpackError:
+        return defaults
+    budget = str(options.vertex_bits)
+    defaults.update(method=native.METHODS[options.method].upper(), max_influences=int(options.max_influences),
+                    budget=budget if budget in ('32', '48', '64') else 'CUSTOM',
+                    builder=native.MESHLET_BUILDERS[meshlets.builder].upper(),
+                    max_vertices=int(meshlets.max_vertices), max_triangles=int(meshlets.max_triangles),
+                    palette_size=int(meshlets.max_joints))
+    return defaults
+
+
+DEFAULTS = _library_defaults()
+LIMITS = native.CONSTANTS
+
+
+def meshlet_limit_properties():
+    """The three meshlet limits as properties (the object's settings and the operator share them)."""
+    return {
+        "max_vertices": IntProperty(name="Max Vertices", default=DEFAULTS["max_vertices"], min=1,
+                                    max=LIMITS["SP_MESHLET_MAX_VERTICES"],
+                                    description="Vertices per meshlet (local indices are 8-bit)"),
+        "max_triangles": IntProperty(name="Max Triangles", default=DEFAULTS["max_triangles"], min=1,
+                                     max=LIMITS["SP_MESHLET_MAX_TRIANGLES"], description="Triangles per meshlet"),
+        "palette_size": IntProperty(name="Palette Size", default=DEFAULTS["palette_size"], min=1,
+                                    max=LIMITS["SP_MESHLET_MAX_JOINTS"],
+                                    description="Distinct joints per meshlet (the joint palette limit)"),
+    }
 
 METHOD_ITEMS = (
     ('OSS', "Optimal Simplex", "Optimal simplex sampling: the densest code for a bit budget (the paper's best)"),
@@ -24,16 +64,17 @@ BUDGET_ITEMS = (
 
 
 class SkinpackMeshSettings(bpy.types.PropertyGroup):
-    method: EnumProperty(name="Method", items=METHOD_ITEMS, default='OSS',
+    method: EnumProperty(name="Method", items=METHOD_ITEMS, default=DEFAULTS["method"],
                          description="Weight codec")
-    budget: EnumProperty(name="Budget", items=BUDGET_ITEMS, default='32',
+    budget: EnumProperty(name="Budget", items=BUDGET_ITEMS, default=DEFAULTS["budget"],
                          description="Bits per vertex for tuple index and weight code, or an error target")
-    custom_bits: IntProperty(name="Bits per Vertex", default=40, min=2, max=64,
+    custom_bits: IntProperty(name="Bits per Vertex", default=40, min=1, max=LIMITS["SP_MAX_VERTEX_BITS"],
                              description="Budget for tuple index + weight code of one vertex")
     max_error: FloatProperty(name="Max Weight Error", default=0.001, min=1e-9, max=0.5, precision=5,
                              description="Largest allowed weight error (L-inf); picks the fewest weight bits "
                                          "whose proven bound meets it")
-    max_influences: IntProperty(name="Max Influences", default=4, min=1, max=4,  # the format's K range
+    max_influences: IntProperty(name="Max Influences", default=DEFAULTS["max_influences"], min=1,
+                                max=LIMITS["SP_MAX_INFLUENCES"],
                                 description="Influences kept per vertex (K); the smallest weights are pruned")
 
     def options_summary(self):
@@ -71,14 +112,11 @@ MESHLET_MODE_ITEMS = (
 
 class SkinpackMeshletSettings(bpy.types.PropertyGroup):
     """Meshlet preview settings of an object and the library's stats of its last preview."""
-    builder: EnumProperty(name="Builder", items=MESHLET_BUILDER_ITEMS, default='SKIN',
+    builder: EnumProperty(name="Builder", items=MESHLET_BUILDER_ITEMS, default=DEFAULTS["builder"],
                           description="Meshlet builder of the library")
-    max_vertices: IntProperty(name="Max Vertices", default=64, min=3, max=255,
-                              description="Vertices per meshlet (local indices are 8-bit)")
-    max_triangles: IntProperty(name="Max Triangles", default=124, min=1, max=512,
-                               description="Triangles per meshlet")
-    palette_size: IntProperty(name="Palette Size", default=32, min=1, max=255,
-                              description="Distinct joints per meshlet (the joint palette limit)")
+    max_vertices: meshlet_limit_properties()["max_vertices"]
+    max_triangles: meshlet_limit_properties()["max_triangles"]
+    palette_size: meshlet_limit_properties()["palette_size"]
 
     # Stats of the preview shown (sp_meshlet_stats), read-only in the panel.
     valid: BoolProperty(default=False, options={'HIDDEN'})

@@ -44,6 +44,17 @@ def main():
 
     # Three cycles: every disable leaves nothing behind, every enable works again.
     obj = common.open_asset(args, "skinned_cylinder.blend", "Cylinder")
+
+    # The settings start at the library's defaults (asked at load, not copied into Python).
+    from skinpack.io import native
+    library, meshlets = native.default_options(), native.meshlet_options()
+    settings, meshlet_settings = obj.data.skinpack, obj.skinpack_meshlets
+    common.check((settings.method.lower(), settings.max_influences, settings.budget)
+                 == (native.METHODS[library.method], library.max_influences, str(library.vertex_bits))
+                 and (meshlet_settings.builder.lower(), meshlet_settings.max_vertices, meshlet_settings.max_triangles,
+                      meshlet_settings.palette_size) == (native.MESHLET_BUILDERS[meshlets.builder], meshlets.max_vertices,
+                                                         meshlets.max_triangles, meshlets.max_joints),
+                 "settings do not start at the library's defaults")
     for cycle in range(3):
         addon_utils.disable("skinpack", default_set=True)
         common.check(registered_names() == [], "cycle %d: residue after disable: %s" % (cycle, registered_names()))
@@ -90,7 +101,8 @@ def main():
             if not item.filename.endswith(".so"):
                 target.writestr(item, source.read(item.filename))
     environment = dict(os.environ, BLENDER_USER_SCRIPTS=os.path.join(args.out, "broken", "scripts"),
-                       BLENDER_USER_CONFIG=os.path.join(args.out, "broken", "config"))
+                       BLENDER_USER_CONFIG=os.path.join(args.out, "broken", "config"),
+                       BLENDER_USER_DATAFILES=os.path.join(args.out, "broken", "datafiles"))
     child = subprocess.run([bpy.app.binary_path, "-b", "--factory-startup", "--python-exit-code", "1",
                             "--python", __file__, "--", "--zip", broken_zip, "--shared", args.shared,
                             "--out", args.out, "--broken-library"],

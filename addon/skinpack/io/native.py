@@ -24,7 +24,7 @@ elif sys.platform == "darwin":
 else:
     LIBRARY_NAME = "libskinpack.so"
 
-_constants = _abi.CONSTANTS
+CONSTANTS = _constants = _abi.CONSTANTS  # every #define SP_* of skinpack.h
 SP_VERSION = _constants["SP_VERSION"]
 SP_MAX_INPUT_INFLUENCES = _constants["SP_MAX_INPUT_INFLUENCES"]
 SP_MAX_INFLUENCES = _constants["SP_MAX_INFLUENCES"]
