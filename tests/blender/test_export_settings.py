@@ -12,7 +12,8 @@
 - Apply Modifiers with a modifier before the Armature: compressed from plain copies, the
   extension matches the exported vertices;
 - a Compact export that cannot compress fails (operator and File > Export), writing nothing, and
-  says why by object name; a single-bone mesh reports no meaningless ratio.
+  says why by object name (operator report; with 4.2+'s export log: an error popup, and
+  is_critical set); a single-bone mesh reports no meaningless ratio.
 """
 
 import os
@@ -134,6 +135,7 @@ def expect_refusal(call, path, *fragments):
     else:
         raise AssertionError("not refused; expected %s" % (fragments,))
     common.check(not os.path.exists(path), "%s was written although the export was refused" % path)
+    return message
 
 
 def check_draco(args, obj):
@@ -179,6 +181,40 @@ def check_apply_modifiers(args, obj):
                      "packed vertices do not match the exported ones")
 
 
+class FakeLog:
+    """Blender 4.2+'s export_settings['log'] (error/warning/info with popup=)."""
+
+    def __init__(self):
+        self.entries = []
+        self.extension = None
+        self.remove = lambda: None
+
+    def error(self, text, popup=False):
+        self.entries.append(("error", text, popup))
+
+    def warning(self, text, popup=False):
+        self.entries.append(("warning", text, popup))
+
+    def info(self, text, popup=False):
+        self.entries.append(("info", text, popup))
+
+
+def with_log_4_2():
+    """Gives the next exports a 4.2-style log: the pre-export callback is wrapped to put one
+    into export_settings, as 4.2+ exporters do before any hook runs."""
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+    log, original = FakeLog(), exporter.pre_export
+
+    def pre_export(export_settings):
+        export_settings["log"] = log
+        log.extension = exporter._our_extension(export_settings)
+        original(export_settings)
+
+    exporter.pre_export = pre_export
+    log.remove = lambda: setattr(exporter, "pre_export", original)
+    return log
+
+
 def check_failed_compact(args, obj):
     """A budget the library refuses: Compact fails and writes nothing, Fallback warns."""
     mesh_settings = obj.data.skinpack
@@ -186,14 +222,20 @@ def check_failed_compact(args, obj):
     try:
         path = os.path.join(args.out, "failed_compact.glb")
         common.make_active(obj)
-        expect_refusal(lambda: bpy.ops.skinpack.export_gltf(filepath=path, mode='COMPACT'), path, obj.name,
-                       "bits per vertex")
+        message = expect_refusal(lambda: bpy.ops.skinpack.export_gltf(filepath=path, mode='COMPACT'), path,
+                                 obj.name, "bits per vertex")
+        common.check("Location:" not in message.splitlines()[-1], "the report hides the error: %s" % message)
         settings = bpy.context.scene.skinpack_export
         settings.enabled, settings.mode = True, 'COMPACT'
+        log = with_log_4_2()
         try:
             expect_refusal(lambda: export(path, obj), path, "Compact export not written", obj.name)
         finally:
             settings.enabled, settings.mode = False, 'FALLBACK'
+            log.remove()
+        common.check(any(level == "error" and popup and obj.name in text for level, text, popup in log.entries),
+                     "no error popup naming %s in the exporter's log: %s" % (obj.name, log.entries))
+        common.check(log.extension is not None and log.extension.is_critical, "is_critical not set")
         fallback = os.path.join(args.out, "failed_fallback.glb")
         common.make_active(obj)
         try:

@@ -49,5 +49,21 @@ def main():
                  and manifest["name"] == bl_info["name"], "manifest and bl_info disagree")
     print("manifest: %s" % manifest)
 
+    # Other platforms' libraries get their own file name and platform tag (make_zip.py).
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "addon"))
+    import make_zip
+    pe = bytearray(256)
+    pe[:2], pe[0x3C:0x40], pe[0x80:0x84], pe[0x84:0x86] = b"MZ", (0x80).to_bytes(4, "little"), b"PE\0\0", \
+        (0x8664).to_bytes(2, "little")
+    macho = b"\xcf\xfa\xed\xfe" + (0x0100000C).to_bytes(4, "little") + bytes(64)
+    for data, expected in ((bytes(pe), ("pe", "windows-x64")), (macho, ("macho", "macos-arm64")),
+                           (b"not a library", (None, None))):
+        path = os.path.join(args.out, "library.bin")
+        with open(path, "wb") as handle:
+            handle.write(data)
+        common.check(make_zip.library_platform(path) == expected, "%r: %s" % (expected, make_zip.library_platform(path)))
+    common.check(make_zip.LIBRARY_NAMES == {"elf": "libskinpack.so", "macho": "libskinpack.dylib",
+                                            "pe": "skinpack.dll"}, "library names")
+
 
 common.run(main)

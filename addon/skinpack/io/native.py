@@ -25,11 +25,8 @@ else:
     LIBRARY_NAME = "libskinpack.so"
 
 CONSTANTS = _constants = _abi.CONSTANTS  # every #define SP_* of skinpack.h
-SP_VERSION = _constants["SP_VERSION"]
-SP_MAX_INPUT_INFLUENCES = _constants["SP_MAX_INPUT_INFLUENCES"]
-SP_MAX_INFLUENCES = _constants["SP_MAX_INFLUENCES"]
-SP_MAX_JOINTS = _constants["SP_MAX_JOINTS"]
-SP_ERROR_HISTOGRAM_BINS = _constants["SP_ERROR_HISTOGRAM_BINS"]
+SP_VERSION, SP_MAX_INPUT_INFLUENCES, SP_MAX_INFLUENCES, SP_MAX_JOINTS = (_constants[name] for name in (
+    "SP_VERSION", "SP_MAX_INPUT_INFLUENCES", "SP_MAX_INFLUENCES", "SP_MAX_JOINTS"))
 
 
 def _enum_names(enum, prefix):
@@ -44,14 +41,10 @@ METHODS = _enum_names("sp_method", "SP_METHOD_")  # index == sp_method value
 MESHLET_BUILDERS = _enum_names("sp_meshlet_builder", "SP_MESHLETS_")  # index == sp_meshlet_builder value
 
 # sp_result values the add-on reacts to (the rest are only shown as messages).
-_results = _abi.ENUMS["sp_result"]
-SP_OK = _results["SP_OK"]
-SP_ERR_INVALID_ARGUMENT = _results["SP_ERR_INVALID_ARGUMENT"]
-SP_ERR_NONFINITE_WEIGHT = _results["SP_ERR_NONFINITE_WEIGHT"]
-SP_ERR_NEGATIVE_WEIGHT = _results["SP_ERR_NEGATIVE_WEIGHT"]
-SP_ERR_NO_INFLUENCE = _results["SP_ERR_NO_INFLUENCE"]
-SP_ERR_JOINT_OUT_OF_RANGE = _results["SP_ERR_JOINT_OUT_OF_RANGE"]
-SP_ERR_LIMIT_EXCEEDED = _results["SP_ERR_LIMIT_EXCEEDED"]
+(SP_OK, SP_ERR_INVALID_ARGUMENT, SP_ERR_NONFINITE_WEIGHT, SP_ERR_NEGATIVE_WEIGHT, SP_ERR_NO_INFLUENCE,
+ SP_ERR_JOINT_OUT_OF_RANGE, SP_ERR_LIMIT_EXCEEDED) = (_abi.ENUMS["sp_result"][name] for name in (
+    "SP_OK", "SP_ERR_INVALID_ARGUMENT", "SP_ERR_NONFINITE_WEIGHT", "SP_ERR_NEGATIVE_WEIGHT", "SP_ERR_NO_INFLUENCE",
+    "SP_ERR_JOINT_OUT_OF_RANGE", "SP_ERR_LIMIT_EXCEEDED"))
 # Results whose error_vertex names a vertex (the others are about parameters).
 PER_VERTEX_ERRORS = (SP_ERR_NONFINITE_WEIGHT, SP_ERR_NEGATIVE_WEIGHT, SP_ERR_NO_INFLUENCE, SP_ERR_JOINT_OUT_OF_RANGE)
 
@@ -79,16 +72,10 @@ def _build_structs():
 
 
 MIRRORED_STRUCTS = _build_structs()
-PrepareStats = MIRRORED_STRUCTS["sp_prepare_stats"]
-Codec = MIRRORED_STRUCTS["sp_codec"]
-ErrorStats = MIRRORED_STRUCTS["sp_error_stats"]
-CompressOptions = MIRRORED_STRUCTS["sp_compress_options"]
-CompressedSkin = MIRRORED_STRUCTS["sp_compressed_skin"]
-MeshletOptions = MIRRORED_STRUCTS["sp_meshlet_options"]
-Meshlet = MIRRORED_STRUCTS["sp_meshlet"]
-MeshletSizes = MIRRORED_STRUCTS["sp_meshlet_sizes"]
-MeshletBuffers = MIRRORED_STRUCTS["sp_meshlet_buffers"]
-MeshletStats = MIRRORED_STRUCTS["sp_meshlet_stats"]
+(PrepareStats, Codec, ErrorStats, CompressOptions, CompressedSkin, MeshletOptions, Meshlet, MeshletSizes,
+ MeshletBuffers, MeshletStats) = (MIRRORED_STRUCTS[name] for name in (
+    "sp_prepare_stats", "sp_codec", "sp_error_stats", "sp_compress_options", "sp_compressed_skin",
+    "sp_meshlet_options", "sp_meshlet", "sp_meshlet_sizes", "sp_meshlet_buffers", "sp_meshlet_stats"))
 
 
 class SkinpackError(Exception):
