@@ -133,7 +133,8 @@ class SKINPACK_OT_preview_meshlets(bpy.types.Operator):
     bl_options = {'REGISTER', 'UNDO'}
 
     mode: EnumProperty(name="Mode", default='MESHLET', items=properties.MESHLET_MODE_ITEMS)
-    builder: EnumProperty(name="Builder", default=properties.DEFAULTS["builder"], items=properties.MESHLET_BUILDER_ITEMS)
+    builder: EnumProperty(name="Builder", default=properties.DEFAULTS["builder"],
+                          items=properties.MESHLET_BUILDER_ITEMS)
     max_vertices: properties.meshlet_limit_properties()["max_vertices"]
     max_triangles: properties.meshlet_limit_properties()["max_triangles"]
     palette_size: properties.meshlet_limit_properties()["palette_size"]
@@ -296,13 +297,10 @@ class SKINPACK_OT_export_gltf(bpy.types.Operator):
 
 def _all_influences_options():
     """Every influence goes into the export (the library keeps the K strongest and says so):
-    export_all_influences up to 4.x, export_influence_nb where that replaced it."""
+    export_all_influences, which 3.4 to 5.x have (4.0+ also has export_influence_nb, ignored
+    when all influences are exported)."""
     properties = bpy.ops.export_scene.gltf.get_rna_type().properties
-    if "export_all_influences" in properties:
-        return {"export_all_influences": True}
-    if "export_influence_nb" in properties:
-        return {"export_influence_nb": int(properties["export_influence_nb"].hard_max)}
-    return {}
+    return {"export_all_influences": True} if "export_all_influences" in properties else {}
 
 
 def _exception_message(error):

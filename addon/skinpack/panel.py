@@ -3,6 +3,7 @@
 import bpy
 
 from . import gather, meshlet_preview, preview, properties, skin_services
+from .blender.exp import gltf2_skinpack_export as exporter
 from .io import native, storage
 
 
@@ -72,7 +73,6 @@ class SKINPACK_PT_skin(bpy.types.Panel):
 def _draw_last_export(layout):
     """What the latest glTF export of this session compressed, pruned and left out, by object
     name: Blender 3.x has no export log to show it, and the console is not where users look."""
-    from .blender.exp import gltf2_skinpack_export as exporter
     report = exporter.last_report
     if not report.compressed and not report.errors:
         return

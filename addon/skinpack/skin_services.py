@@ -70,9 +70,12 @@ def pruning_text(stats):
     """'' when no vertex lost an influence, else how many, from how many, and the weight change."""
     if not stats["pruned_vertices"]:
         return ""
-    most = "%d%s" % (stats["max_input_influences"], " or more" if stats["max_input_influences_capped"] else "")
-    return ("%d vertices pruned to %d influences (up to %s before), max weight change %.3f"
-            % (stats["pruned_vertices"], stats["influences"], most, stats["max_pruning_error"]))
+    before = ""
+    if "max_input_influences" in stats:  # results stored by older versions lack it
+        before = " (up to %d%s before)" % (stats["max_input_influences"],
+                                           " or more" if stats["max_input_influences_capped"] else "")
+    return ("%d vertices pruned to %d influences%s, max weight change %.3f"
+            % (stats["pruned_vertices"], stats["influences"], before, stats["max_pruning_error"]))
 
 
 def stats_line(stats):
@@ -111,6 +114,7 @@ def restore_originals(obj):
     if not (len(counts) == len(current_counts) and (counts == current_counts).all()
             and (groups == current_groups).all()):
         raise preview.PreviewError("%s: vertices or group memberships changed while the decoded weights were "
-                                   "shown; originals kept in the mesh's '%s' property" % (obj.name, storage.ORIGINAL_KEY))
+                                   "shown; originals kept in the mesh's '%s' property"
+                                   % (obj.name, storage.ORIGINAL_KEY))
     gather.write_element_weights(mesh, counts, weights, current_weights)
     storage.clear_originals(mesh)

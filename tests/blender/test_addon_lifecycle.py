@@ -52,8 +52,9 @@ def main():
     common.check((settings.method.lower(), settings.max_influences, settings.budget)
                  == (native.METHODS[library.method], library.max_influences, str(library.vertex_bits))
                  and (meshlet_settings.builder.lower(), meshlet_settings.max_vertices, meshlet_settings.max_triangles,
-                      meshlet_settings.palette_size) == (native.MESHLET_BUILDERS[meshlets.builder], meshlets.max_vertices,
-                                                         meshlets.max_triangles, meshlets.max_joints),
+                      meshlet_settings.palette_size)
+                 == (native.MESHLET_BUILDERS[meshlets.builder], meshlets.max_vertices, meshlets.max_triangles,
+                     meshlets.max_joints),
                  "settings do not start at the library's defaults")
     for cycle in range(3):
         addon_utils.disable("skinpack", default_set=True)

@@ -115,7 +115,8 @@ def check_color_export(args, obj):
             color_0 = glb.accessor(attributes["COLOR_0"])
             common.check(np.allclose(color_0, USER_COLORS["paint_a"], atol=1e-3),
                          "COLOR_0 is not the user's render colour: %s" % color_0[:2])
-            common.check((EXTENSION in primitive.get("extensions", {})) == enabled, "extension when enabled=%s" % enabled)
+            common.check((EXTENSION in primitive.get("extensions", {})) == enabled,
+                         "extension when enabled=%s" % enabled)
         common.check((color_state(mesh), user_color_state(mesh)) == state, "the export changed the mesh's colours")
         common.check(mesh.color_attributes.get("skinpack_error") is not None, "the preview did not come back")
     bpy.context.scene.skinpack_export.enabled = False

@@ -121,7 +121,8 @@ def main():
         bpy.ops.export_scene.gltf(filepath=via_exporter, export_format='GLB', use_selection=True)
         export_settings.enabled, export_settings.mode = False, 'FALLBACK'
         check_contract(via_exporter, compact=True)
-        common.check(exporter.last_report.compressed and all(entry[0] == name for entry in exporter.last_report.compressed),
+        compressed = exporter.last_report.compressed
+        common.check(compressed and all(entry[0] == name for entry in compressed),
                      "export report does not name %s: %s" % (name, exporter.last_report.compressed))
 
         # With the error preview on, the heat map (the render colour) must not become COLOR_0.

@@ -61,7 +61,8 @@ def main():
         path = os.path.join(args.out, "library.bin")
         with open(path, "wb") as handle:
             handle.write(data)
-        common.check(make_zip.library_platform(path) == expected, "%r: %s" % (expected, make_zip.library_platform(path)))
+        found = make_zip.library_platform(path)
+        common.check(found == expected, "%r: %s" % (expected, found))
     common.check(make_zip.LIBRARY_NAMES == {"elf": "libskinpack.so", "macho": "libskinpack.dylib",
                                             "pe": "skinpack.dll"}, "library names")
 

@@ -179,7 +179,7 @@ class glTF2ExportUserExtension:
         if not self.enabled:
             return
         if native.load() is None:
-            self._fail(export_settings, native.load_error())
+            self.report_error(export_settings, native.load_error())
             return
         # A mesh used by several skinned nodes is compressed once, with the largest joint count.
         joint_counts, meshes = {}, {}
@@ -197,7 +197,7 @@ class glTF2ExportUserExtension:
             _log(export_settings, "warning", message)
         _log(export_settings, "info", last_report.summary())
 
-    def _fail(self, export_settings, message):
+    def report_error(self, export_settings, message):
         last_report.errors.append(message)
         self.is_critical = self.is_critical or self.compact
         _log(export_settings, "error", message)
@@ -208,15 +208,15 @@ class glTF2ExportUserExtension:
             arrays = source.arrays.get(cache_key) if source is not None else None
             if arrays is None:
                 if "JOINTS_0" in primitive.attributes:
-                    self._fail(export_settings, "%s: the skin of a primitive could not be read; left uncompressed"
-                               % (mesh.name or "<unnamed mesh>"))
+                    self.report_error(export_settings, "%s: the skin of a primitive could not be read; left "
+                                      "uncompressed" % (mesh.name or "<unnamed mesh>"))
                 return
             joints, weights = arrays
             try:
                 compressed, stats = skin_services.compress_skin(source.object_name, joints, weights,
                                                                 joint_count, source.settings)
             except (native.SkinpackError, ValueError) as error:
-                self._fail(export_settings, "%s; primitive left uncompressed" % error)
+                self.report_error(export_settings, "%s; primitive left uncompressed" % error)
                 return
             Extension = gltf_api.extension_class()
             self.done[cache_key] = Extension(ext.EXTENSION_NAME, extension_json(compressed, joint_count),
@@ -249,7 +249,7 @@ def pre_export(export_settings):
     extension = _our_extension(export_settings)
     if extension is not None and extension.enabled and export_settings.get("gltf_draco_mesh_compression"):
         message = "Draco reorders vertices: turn off Draco or Skinpack (nothing written)"
-        extension._fail(export_settings, message)
+        extension.report_error(export_settings, message)
         raise ExportRefused("Skinpack: " + message)
     _detached_previews.extend(preview.detach_previews(bpy.data.meshes))
 
