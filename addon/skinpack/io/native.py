@@ -277,7 +277,8 @@ class Compressed:
 
 
 def compress(joints, weights, joint_count, options):
-    """joints (V, S) uint16 and weights (V, S) float32, S = influences per vertex (1..8)."""
+    """joints (V, S) uint16 and weights (V, S) float32, S influence slots per vertex (any number:
+    the library keeps the K strongest)."""
     lib = _require()
     joints = np.ascontiguousarray(joints, dtype=np.uint16)
     weights = np.ascontiguousarray(weights, dtype=np.float32)
