@@ -250,6 +250,38 @@ def check_failed_compact(args, obj):
         mesh_settings.budget = '32'
 
 
+def check_exporter_failure(args, obj):
+    """The exporter itself fails between the callbacks: the preview comes back (operator at once,
+    File > Export at the UI's next idle moment through a timer) and the mesh is as before."""
+    from io_scene_gltf2.blender.exp import gltf2_blender_export
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+    mesh = obj.data
+    bpy.ops.skinpack.preview_error(mode='WEIGHT')
+    state = color_state(mesh), user_color_state(mesh)
+    original = gltf2_blender_export.__dict__["__export"]
+
+    def failing_export(export_settings):
+        raise RuntimeError("exporter failure for the test")
+
+    gltf2_blender_export.__dict__["__export"] = failing_export
+    try:
+        path = os.path.join(args.out, "exporter_failure.glb")
+        common.make_active(obj)
+        expect_refusal(lambda: bpy.ops.skinpack.export_gltf(filepath=path, mode='FALLBACK'), path,
+                       "exporter failure for the test")
+        common.check((color_state(mesh), user_color_state(mesh)) == state, "operator: preview not restored")
+        expect_refusal(lambda: export(path, obj), path, "exporter failure for the test")
+        common.check(mesh.color_attributes.get("skinpack_error") is None, "the preview was exported")
+        common.check(bpy.app.timers.is_registered(exporter._restore_after_failure), "no restore timer")
+        exporter._restore_after_failure()  # what the timer does once the UI is idle again
+        common.check((color_state(mesh), user_color_state(mesh)) == state, "timer: preview not restored")
+    finally:
+        gltf2_blender_export.__dict__["__export"] = original
+        if bpy.app.timers.is_registered(exporter._restore_after_failure):
+            bpy.app.timers.unregister(exporter._restore_after_failure)
+    bpy.ops.skinpack.clear_preview()
+
+
 def check_single_bone_message(obj):
     from skinpack import skin_services
     from skinpack.io import storage
@@ -281,6 +313,7 @@ def main():
     check_draco(args, obj)
     check_apply_modifiers(args, obj)
     check_failed_compact(args, obj)
+    check_exporter_failure(args, obj)
     check_single_bone_message(obj)
 
 

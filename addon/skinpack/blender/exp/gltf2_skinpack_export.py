@@ -252,6 +252,15 @@ def pre_export(export_settings):
         extension.report_error(export_settings, message)
         raise ExportRefused("Skinpack: " + message)
     _detached_previews.extend(preview.detach_previews(bpy.data.meshes))
+    # An exporter error before post_export leaves them detached: the UI's next idle moment puts
+    # them back (timers cannot run during the export, which holds the main thread).
+    if _detached_previews and not bpy.app.timers.is_registered(_restore_after_failure):
+        bpy.app.timers.register(_restore_after_failure, first_interval=0.1)
+
+
+def _restore_after_failure():
+    restore_previews()
+    return None  # once
 
 
 def post_export(export_settings):
@@ -331,6 +340,8 @@ def register():
 def unregister():
     unregister_panel()
     restore_previews()
+    if bpy.app.timers.is_registered(_restore_after_failure):
+        bpy.app.timers.unregister(_restore_after_failure)
     if bpy.app.version >= (4, 2, 0):
         try:
             import io_scene_gltf2
