@@ -194,7 +194,16 @@ def _wrap(text, width):
     return lines + ([line] if line else [])
 
 
-classes = (SKINPACK_PT_skin,)
+class SKINPACK_PT_skin_sidebar(SKINPACK_PT_skin):
+    """The same panel in the 3D viewport's sidebar (N), Skinpack tab: where the artist works,
+    since in Object Data it can only come after Blender's own panels."""
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Skinpack"
+    bl_context = "objectmode"
+
+
+classes = (SKINPACK_PT_skin, SKINPACK_PT_skin_sidebar)
 
 
 register, unregister = bpy.utils.register_classes_factory(classes)

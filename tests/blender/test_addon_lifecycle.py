@@ -14,7 +14,8 @@ import bpy  # noqa: E402
 
 OPERATORS = ("compress", "preview_error", "clear_preview", "toggle_decoded", "export_gltf", "preview_meshlets")
 TYPES = ("SKINPACK_OT_compress", "SKINPACK_OT_preview_error", "SKINPACK_OT_clear_preview",
-         "SKINPACK_OT_toggle_decoded", "SKINPACK_OT_export_gltf", "SKINPACK_OT_preview_meshlets", "SKINPACK_PT_skin")
+         "SKINPACK_OT_toggle_decoded", "SKINPACK_OT_export_gltf", "SKINPACK_OT_preview_meshlets", "SKINPACK_PT_skin",
+         "SKINPACK_PT_skin_sidebar")
 CLASSES = []  # every class the add-on registers, collected while it is enabled
 
 
