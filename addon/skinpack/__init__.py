@@ -29,9 +29,12 @@ import sys  # noqa: E402
 
 # Re-enabling after an update re-runs this file in the same module: drop the old submodules so
 # that the imports below load the new files (and the new library copy), not a mix of versions.
+# `from . import x` would hand back the old submodule still bound in this namespace, so those
+# names go too.
 if "bpy" in locals():
     for _name in [name for name in sys.modules if name.startswith(__name__ + ".")]:
         del sys.modules[_name]
+        globals().pop(_name[len(__name__) + 1:].split(".")[0], None)
 
 import bpy  # noqa: E402
 

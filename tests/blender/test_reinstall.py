@@ -88,7 +88,10 @@ def main():
         # Reload (disable, enable): the new files and the new library copy, the old one untouched.
         addon_utils.disable("skinpack", default_set=True)
         addon_utils.enable("skinpack", default_set=True, handle_error=common._raise)
-        from skinpack.io import native as reloaded
+        # The modules the add-on itself uses now (not a fresh import by this test).
+        reloaded = sys.modules["skinpack"].operators.native
+        common.check(reloaded is sys.modules["skinpack.io.native"] and reloaded is not native,
+                     "the re-enabled add-on still runs the old modules")
         compress_cylinder(args)
         second = reloaded.loaded_path()
         common.check(second != first and os.path.isfile(first) and digest(first) == first_digest,
