@@ -401,6 +401,10 @@ typedef struct sp_packed_params {
     double max_error;           /* "maxError" when has_max_error */
 } sp_packed_params;
 
+/* 1 if two primitives declare the same parameters (every field; axis_samples only up to
+ * axis_sample_count), else 0. Primitives that share a "vertices" accessor must (docs/extension). */
+SP_API int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b);
+
 /* The optional meshlet arrays (docs/extension: "meshlets"), each widened to the type here. */
 typedef struct sp_packed_meshlets {
     size_t meshlet_count;

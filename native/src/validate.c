@@ -240,3 +240,15 @@ sp_result sp_validate_packed(const sp_packed_primitive* primitive, uint16_t* out
     }
     return r;
 }
+
+int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b)
+{
+    if (!a || !b) return 0;
+    int same = a->method == b->method && a->influences == b->influences && a->joint_count == b->joint_count &&
+               a->weight_bits == b->weight_bits && a->tuple_bits == b->tuple_bits && a->n == b->n &&
+               a->axis_sample_count == b->axis_sample_count && a->has_max_error == b->has_max_error &&
+               (!a->has_max_error || a->max_error == b->max_error);
+    for (uint32_t i = 0; same && i < a->axis_sample_count && i < SP_MAX_INFLUENCES - 1; ++i)
+        same = a->axis_samples[i] == b->axis_samples[i];
+    return same;
+}

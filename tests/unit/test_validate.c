@@ -189,6 +189,25 @@ static void bad_parameters(const packed* base)
     EXPECT(bad.params.joint_count = 2, SP_ERR_JOINT_OUT_OF_RANGE, SP_FIELD_TUPLE_TABLE, "not below jointCount 2 at tuple");
 }
 
+/* Primitives sharing accessors must declare the same; unused axis entries do not count. */
+static void shared_parameters(const packed* base)
+{
+    sp_packed_params a = base->prim.params, b = a;
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b.axis_samples[2] = 77; /* not declared: OSS has no axisSamples */
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b = a, b.joint_count += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.n += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.max_error *= 2;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.has_max_error = 0;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.method = SP_METHOD_ANY, b.axis_sample_count = 3;
+    CHECK(sp_packed_params_equal(&a, &b) == 0 && sp_packed_params_equal(&a, NULL) == 0);
+}
+
 /* Corrupt words and tables, each named by vertex. */
 static void bad_data(packed* base)
 {
@@ -324,6 +343,7 @@ int main(void)
     o.weight_bits = 20; /* spare high bits for the corruptions */
     CHECK(compress(&o, &base) == SP_OK);
     bad_parameters(&base);
+    shared_parameters(&base);
     bad_data(&base);
     meshlets(&base);
     return check_report("test_validate");
