@@ -13,7 +13,8 @@
  * sp_result_string() turns it into a message. "K" is the number of influences kept per vertex
  * (1..4); per-vertex arrays of influences are dense, K (or the input stride) entries a vertex.
  *
- * The exact bit layout the library writes is specified in docs/format.md.
+ * The format is specified in docs/extension/README.md (1.0; conformance vectors in
+ * docs/extension/conformance/) and explained in docs/format.md.
  */
 #ifndef SKINPACK_H
 #define SKINPACK_H
