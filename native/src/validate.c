@@ -20,6 +20,19 @@ static sp_result fail(sp_validation* report, sp_result result, sp_field field, s
     return result;
 }
 
+int sp_find_duplicate_joint(const uint16_t* joints, const float* weights, uint32_t k, uint32_t* slot,
+                            uint32_t* other_slot)
+{
+    for (uint32_t a = 0; a < k; ++a)
+        for (uint32_t b = a + 1; b < k; ++b)
+            if (joints[a] == joints[b] && weights[a] > 0 && weights[b] > 0) {
+                *slot = a;
+                *other_slot = b;
+                return 1;
+            }
+    return 0;
+}
+
 /* Ranges of the declared integers and the method's own rules for n and axisSamples. */
 static sp_result check_params(const sp_packed_params* p, sp_validation* report)
 {
@@ -110,13 +123,8 @@ static sp_result decode_vertex(const sp_packed_primitive* prim, size_t v, uint16
     if (sp_decode_weights_batch(codec, &code, 1, weights, NULL) != SP_OK)
         return fail(report, SP_ERR_CODE_OUTSIDE_SIMPLEX, SP_FIELD_VERTICES, v, code, codec->max_code);
     memcpy(joints, prim->lut + (size_t)tuple * k, k * sizeof(uint16_t));
-    for (uint32_t a = 0; a < k; ++a)
-        for (uint32_t b = a + 1; b < k; ++b)
-            if (joints[a] == joints[b] && weights[a] > 0 && weights[b] > 0) {
-                report->slot = a;
-                report->other_slot = b;
-                return fail(report, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, v, joints[a], tuple);
-            }
+    if (sp_find_duplicate_joint(joints, weights, k, &report->slot, &report->other_slot))
+        return fail(report, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, v, joints[report->slot], tuple);
     return SP_OK;
 }
 

@@ -13,7 +13,8 @@ extension, whose decoded joints are all below the joint count of the skin and di
 weighted.
 
 Not registered in ctest yet: the CLI does not call sp_validate_packed (issue 10 wires it), and
-until then this script reports the reader holes it finds.
+until then this script reports the reader holes it finds (today: a `vertices` accessor shorter
+than the primitive is decoded and written).
 """
 import copy
 import json

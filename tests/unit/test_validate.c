@@ -241,6 +241,13 @@ static void bad_data(packed* base)
     char text[64];
     snprintf(text, sizeof(text), "carries weight in slots 0 and 1 (tuple %u) at vertex", tuple);
     EXPECT(bad.lut = lut, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, text);
+    /* the older decoder applies the same rule */
+    static uint16_t joints[4 * V];
+    static float weights[4 * V];
+    size_t bad_vertex = V;
+    CHECK(sp_decompress_skin(&base->info.codec, base->words, V, tb, lut, prim->lut_size, JOINTS, joints, weights,
+                             &bad_vertex) == SP_ERR_DUPLICATE_JOINT);
+    CHECK(bad_vertex <= v);
 }
 
 /* Grid methods: an unsorted grid point; Any: a point past the simplex (w1 < 0). */
