@@ -22,6 +22,11 @@ static void abi_and_rules(void)
     CHECK(sp_check_abi(SP_VERSION + 1, sizes, 0, &bad) == SP_ERR_ABI_MISMATCH && bad == SP_STRUCT_COUNT);
     CHECK(sp_check_abi(SP_VERSION, sizes, SP_STRUCT_MESHLET, &bad) == SP_OK); /* an older, shorter list */
 
+    for (int r = 0; r < SP_RESULT_COUNT; ++r) /* every code, the validation ones included, has its message */
+        CHECK_MSG(strcmp(sp_result_string((sp_result)r), "unknown result code") != 0, "result %d", r);
+    for (int f = 1; f < SP_FIELD_COUNT; ++f) CHECK_MSG(sp_field_name((sp_field)f)[0] != 0, "field %d", f);
+    CHECK(sp_field_name(SP_FIELD_COUNT)[0] == 0);
+
     CHECK(sp_joint_bytes(0) == 0 && sp_joint_bytes(1) == 1 && sp_joint_bytes(256) == 1);
     CHECK(sp_joint_bytes(257) == 2 && sp_joint_bytes(65535) == 2 && sp_joint_bytes(65536) == 0);
 
