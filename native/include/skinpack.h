@@ -13,7 +13,8 @@
  * sp_result_string() turns it into a message. "K" is the number of influences kept per vertex
  * (1..4); per-vertex arrays of influences are dense, K (or the input stride) entries a vertex.
  *
- * The exact bit layout the library writes is specified in docs/format.md.
+ * The format is specified in docs/extension/README.md (1.0; conformance vectors in
+ * docs/extension/conformance/) and explained in docs/format.md.
  */
 #ifndef SKINPACK_H
 #define SKINPACK_H
@@ -296,9 +297,11 @@ SP_API sp_result sp_compress_skin(const uint16_t* joints, const float* weights, 
                                   size_t scratch_size);
 
 /*
- * Decodes packed words back to K joints and K weights per vertex, validating everything a file
- * may get wrong: codes above max_code or of invalid tuples, tuple indices >= lut_size, LUT joints >= joint_count,
- * non-zero padding bits. error_vertex (may be NULL) names the first bad vertex.
+ * Decodes packed words back to K joints and K weights per vertex, validating what the words and
+ * table may get wrong: codes above max_code or of invalid tuples, tuple indices >= lut_size, LUT
+ * joints >= joint_count, non-zero padding bits, a joint in two weighted slots
+ * (SP_ERR_DUPLICATE_JOINT). error_vertex (may be NULL) names the first bad vertex.
+ * sp_validate_packed checks everything else a file may get wrong, too.
  */
 SP_API sp_result sp_decompress_skin(const sp_codec* codec, const uint32_t* words, size_t vertex_count,
                                     uint32_t tuple_bits, const uint16_t* lut, size_t lut_size,
@@ -402,6 +405,10 @@ typedef struct sp_packed_params {
     uint32_t has_max_error;
     double max_error;           /* "maxError" when has_max_error */
 } sp_packed_params;
+
+/* 1 if two primitives declare the same parameters (every field; axis_samples only up to
+ * axis_sample_count), else 0. Primitives that share a "vertices" accessor must (docs/extension). */
+SP_API int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b);
 
 /* The optional meshlet arrays (docs/extension: "meshlets"), each widened to the type here. */
 typedef struct sp_packed_meshlets {

@@ -6,67 +6,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "skinpack.h"
 
-enum { GRID = 32, V = GRID * GRID, JOINTS = 40, TRIS = (GRID - 1) * (GRID - 1) * 2 };
-
-static uint16_t in_joints[V * 4];
-static float in_weights[V * 4];
-static float positions[V * 3];
-static uint32_t indices[TRIS * 3];
-
-/* A square sheet of vertices, each weighted to 1..4 joints of a chain along x. */
-static void make_mesh(size_t influences)
-{
-    for (size_t y = 0; y < GRID; ++y)
-        for (size_t x = 0; x < GRID; ++x) {
-            size_t v = y * GRID + x;
-            positions[v * 3] = (float)x, positions[v * 3 + 1] = (float)y, positions[v * 3 + 2] = 0;
-            double t = (double)x / GRID * (JOINTS - 4), sum = 0, raw[4];
-            size_t count = influences == 1 ? 1 : 1 + (x * 7 + y * 3) % influences;
-            for (size_t i = 0; i < 4; ++i) {
-                in_joints[v * 4 + i] = (uint16_t)((size_t)t + i);
-                raw[i] = i < count ? exp(-fabs(t - (double)((size_t)t + i)) * (1.0 + 0.1 * (double)y)) : 0;
-                sum += raw[i];
-            }
-            for (size_t i = 0; i < 4; ++i) in_weights[v * 4 + i] = (float)(raw[i] / sum);
-        }
-    size_t at = 0;
-    for (uint32_t y = 0; y + 1 < GRID; ++y)
-        for (uint32_t x = 0; x + 1 < GRID; ++x) {
-            uint32_t a = y * GRID + x, b = a + 1, c = a + GRID, d = c + 1;
-            uint32_t quad[6] = {a, b, d, a, d, c};
-            memcpy(indices + at, quad, sizeof(quad));
-            at += 6;
-        }
-}
-
-typedef struct packed {
-    uint32_t words[2 * V];
-    uint16_t lut[4 * V];
-    sp_compressed_skin info;
-    sp_packed_primitive prim;
-} packed;
-
-static sp_result compress(const sp_compress_options* o, packed* p)
-{
-    size_t size = sp_compress_scratch_bound(V, 4);
-    void* scratch = malloc(size);
-    sp_result r = sp_compress_skin(in_joints, in_weights, V, 4, JOINTS, o, p->words, p->lut, NULL, NULL, &p->info,
-                                   scratch, size);
-    free(scratch);
-    const sp_compressed_skin* s = &p->info;
-    sp_packed_params params = {s->codec.method, s->influences, s->joint_count, s->weight_bits, s->tuple_bits,
-                               s->codec.n, {0}, 0, 1, s->codec.max_error};
-    if (s->codec.method == SP_METHOD_ANY) {
-        params.axis_sample_count = s->influences - 1;
-        memcpy(params.axis_samples, s->codec.axis_samples, sizeof(params.axis_samples));
-    }
-    sp_packed_primitive prim = {params, p->words, V, s->words_per_vertex, V, p->lut, s->lut_size, s->influences,
-                                sp_joint_bytes(JOINTS), JOINTS, NULL};
-    p->prim = prim;
-    return r;
-}
+#include "packed_fixture.h"
 
 static void abi_and_rules(void)
 {
@@ -80,6 +21,11 @@ static void abi_and_rules(void)
     CHECK(sp_check_abi(SP_VERSION, sizes, SP_STRUCT_COUNT, &bad) == SP_ERR_ABI_MISMATCH && bad == SP_STRUCT_MESHLET);
     CHECK(sp_check_abi(SP_VERSION + 1, sizes, 0, &bad) == SP_ERR_ABI_MISMATCH && bad == SP_STRUCT_COUNT);
     CHECK(sp_check_abi(SP_VERSION, sizes, SP_STRUCT_MESHLET, &bad) == SP_OK); /* an older, shorter list */
+
+    for (int r = 0; r < SP_RESULT_COUNT; ++r) /* every code, the validation ones included, has its message */
+        CHECK_MSG(strcmp(sp_result_string((sp_result)r), "unknown result code") != 0, "result %d", r);
+    for (int f = 1; f < SP_FIELD_COUNT; ++f) CHECK_MSG(sp_field_name((sp_field)f)[0] != 0, "field %d", f);
+    CHECK(sp_field_name(SP_FIELD_COUNT)[0] == 0);
 
     CHECK(sp_joint_bytes(0) == 0 && sp_joint_bytes(1) == 1 && sp_joint_bytes(256) == 1);
     CHECK(sp_joint_bytes(257) == 2 && sp_joint_bytes(65535) == 2 && sp_joint_bytes(65536) == 0);
@@ -223,18 +169,18 @@ static void valid_primitives(void)
 static void bad_parameters(const packed* base)
 {
     EXPECT(bad.params.method = SP_METHOD_COUNT, SP_ERR_UNSUPPORTED_METHOD, SP_FIELD_METHOD, "method: unknown");
-    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 out of range");
+    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 above the maximum 4");
     EXPECT(bad.params.influences = (uint64_t)1 << 32 | 4, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences");
-    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 out of range");
+    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 below the minimum 1");
     EXPECT(bad.params.joint_count = 70000, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount");
-    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65");
+    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65 above the maximum 64");
     EXPECT(bad.params.weight_bits -= 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits");
     EXPECT(bad.params.tuple_bits += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_TUPLE_BITS, "tupleBits");
     EXPECT(bad.params.tuple_bits = 33, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_TUPLE_BITS, "tupleBits: 33");
-    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 out of range");
+    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 below the minimum 2");
     EXPECT(bad.params.n = ((uint64_t)1 << 63) + 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n:");
     EXPECT(bad.params.n += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits"); /* n of more bits */
-    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000"); /* K = 4: > 64 bits */
+    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000 needs weight codes of more than 64 bits"); /* K = 4: > 64 bits */
     EXPECT(bad.params.axis_sample_count = 3, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_AXIS_SAMPLES, "axisSamples");
     EXPECT((bad.params.has_max_error = 1, bad.params.max_error = NAN), SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MAX_ERROR,
            "maxError: not a number");
@@ -246,6 +192,25 @@ static void bad_parameters(const packed* base)
            "vertices: 1024 packed vertices, the primitive has 1025");
     EXPECT(bad.lut_size = 0, SP_ERR_INDEX_OUT_OF_RANGE, SP_FIELD_TUPLE_TABLE, "tupleTable");
     EXPECT(bad.params.joint_count = 2, SP_ERR_JOINT_OUT_OF_RANGE, SP_FIELD_TUPLE_TABLE, "not below jointCount 2 at tuple");
+}
+
+/* Primitives sharing accessors must declare the same; unused axis entries do not count. */
+static void shared_parameters(const packed* base)
+{
+    sp_packed_params a = base->prim.params, b = a;
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b.axis_samples[2] = 77; /* not declared: OSS has no axisSamples */
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b = a, b.joint_count += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.n += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.max_error *= 2;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.has_max_error = 0;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.method = SP_METHOD_ANY, b.axis_sample_count = 3;
+    CHECK(sp_packed_params_equal(&a, &b) == 0 && sp_packed_params_equal(&a, NULL) == 0);
 }
 
 /* Corrupt words and tables, each named by vertex. */
@@ -281,6 +246,13 @@ static void bad_data(packed* base)
     char text[64];
     snprintf(text, sizeof(text), "carries weight in slots 0 and 1 (tuple %u) at vertex", tuple);
     EXPECT(bad.lut = lut, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, text);
+    /* the older decoder applies the same rule */
+    static uint16_t joints[4 * V];
+    static float weights[4 * V];
+    size_t bad_vertex = V;
+    CHECK(sp_decompress_skin(&base->info.codec, base->words, V, tb, lut, prim->lut_size, JOINTS, joints, weights,
+                             &bad_vertex) == SP_ERR_DUPLICATE_JOINT);
+    CHECK(bad_vertex <= v);
 }
 
 /* Grid methods: an unsorted grid point; Any: a point past the simplex (w1 < 0). */
@@ -320,50 +292,6 @@ static void codes_outside_simplex(void)
         CHECK_MSG(sp_validate_packed(&bad, NULL, NULL, &report) == SP_ERR_CODE_OUTSIDE_SIMPLEX, "method %d", m);
         CHECK(message_has(&report, "outside the simplex at vertex 812"));
     }
-}
-
-/* Meshlet arrays as sp_build_meshlets writes them, widened to the validator's types. */
-typedef struct meshlet_arrays {
-    sp_meshlet meshlets[TRIS];
-    uint32_t vertices[TRIS * 3], offsets[TRIS * 4], counts[TRIS * 4];
-    uint8_t vertex_tuples[TRIS * 3], triangles[TRIS * 3], tuples[TRIS * 3 * 4];
-    uint16_t joints[TRIS * 12];
-    sp_packed_meshlets view;
-} meshlet_arrays;
-
-static int build_meshlets(const packed* p, meshlet_arrays* a)
-{
-    static uint16_t joints[V * 4];
-    static float weights[V * 4];
-    uint32_t k = p->info.influences;
-    if (sp_validate_packed(&p->prim, joints, weights, NULL) != SP_OK) return -1;
-    sp_meshlet_options options;
-    sp_meshlet_options_default(&options);
-    sp_meshlet_sizes sizes;
-    sp_meshlets_bound(TRIS * 3, V, k, &options, &sizes);
-    if (sizes.meshlets > TRIS || sizes.vertices > TRIS * 3 || sizes.joints > TRIS * 12 || sizes.tuples > TRIS * 3)
-        return -1;
-    sp_meshlet_buffers out = {a->meshlets, a->vertices, a->vertex_tuples, a->triangles, a->joints, a->tuples, NULL,
-                              sizes};
-    void* scratch = malloc(sizes.scratch_bytes);
-    sp_meshlet_stats stats;
-    sp_result r = sp_build_meshlets(indices, TRIS * 3, positions, V, 12, joints, weights, k, &options, &out, scratch,
-                                    sizes.scratch_bytes, &stats);
-    free(scratch);
-    if (r != SP_OK) return -1;
-    for (size_t m = 0; m < stats.meshlet_count; ++m) {
-        const sp_meshlet* ml = &a->meshlets[m];
-        uint32_t o[4] = {ml->vertex_offset, ml->triangle_offset, ml->joint_offset, ml->tuple_offset};
-        uint32_t c[4] = {ml->vertex_count, ml->triangle_count, ml->joint_count, ml->tuple_count};
-        memcpy(a->offsets + 4 * m, o, sizeof(o));
-        memcpy(a->counts + 4 * m, c, sizeof(c));
-    }
-    sp_packed_meshlets view = {stats.meshlet_count, a->offsets, a->counts, stats.vertex_count, a->vertices,
-                               a->vertex_tuples, stats.triangle_count * 3, a->triangles, stats.joint_count, a->joints,
-                               stats.tuple_count, a->tuples, options.max_vertices, options.max_triangles,
-                               options.max_joints};
-    a->view = view;
-    return 0;
 }
 
 static void meshlets(packed* base)
@@ -408,7 +336,7 @@ static void meshlets(packed* base)
     EXPECT(bad.meshlets = &b.view, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_MESHLET_TUPLES, "where the vertex decodes to");
     b = a;
     b.view.max_joints = 300;
-    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300");
+    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300 above the maximum 255");
     base->prim.meshlets = NULL;
 }
 
@@ -427,6 +355,7 @@ int main(void)
     o.weight_bits = 20; /* spare high bits for the corruptions */
     CHECK(compress(&o, &base) == SP_OK);
     bad_parameters(&base);
+    shared_parameters(&base);
     bad_data(&base);
     meshlets(&base);
     return check_report("test_validate");
