@@ -1,0 +1,55 @@
+// cases.mjs - the compressed files every web test reads: each asset in fallback and compact
+// mode, and Fox in every method and width (narrow Number path and 64-bit BigInt path), made
+// with the skinpack CLI; plus the ground truth `skinpack decompress` writes for each.
+import { execFileSync } from 'node:child_process';
+import { existsSync, mkdirSync } from 'node:fs';
+import { basename, join } from 'node:path';
+
+export const CLI = process.env.SKINPACK_CLI;
+export const WORK = process.env.SKINPACK_WEB_WORK || '/tmp/skinpack_web';
+// Colon-separated .glb paths; Fox first.
+export const ASSETS = (process.env.SKINPACK_WEB_ASSETS || '').split(':').filter(Boolean);
+
+export const FOX_VARIANTS = {
+  fixed24: ['--method', 'fixed', '--weight-bits', '24'],
+  cube21: ['--method', 'cube', '--weight-bits', '21'],
+  pot20: ['--method', 'pot', '--weight-bits', '20'],
+  any22: ['--method', 'any', '--weight-bits', '22'],
+  oss48: ['--method', 'oss', '--vertex-bits', '48'],
+  oss64: ['--method', 'oss', '--vertex-bits', '64'],
+  any64: ['--method', 'any', '--vertex-bits', '64'],
+  fixed64: ['--method', 'fixed', '--vertex-bits', '64'],
+  cube64: ['--method', 'cube', '--vertex-bits', '64'],
+  pot40: ['--method', 'pot', '--vertex-bits', '40'],
+  k1: ['--max-influences', '1'],
+  k2: ['--max-influences', '2', '--vertex-bits', '24'],
+  k3: ['--max-influences', '3', '--vertex-bits', '32'],
+  k3w: ['--max-influences', '3', '--vertex-bits', '62'],
+};
+
+function run(args) {
+  return execFileSync(CLI, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+}
+
+/** Compresses (once per work folder) and decompresses; returns {name, source, packed, decoded}. */
+export function makeCase(source, tag, args) {
+  if (!CLI) throw new Error('SKINPACK_CLI is not set (the ctest registration sets it)');
+  mkdirSync(WORK, { recursive: true });
+  const name = `${basename(source, '.glb')}_${tag}`;
+  const packed = join(WORK, `${name}.glb`), decoded = join(WORK, `${name}_decoded.glb`);
+  if (!existsSync(packed)) run(['compress', source, '-o', packed, ...args]);
+  if (!existsSync(decoded)) run(['decompress', packed, '-o', decoded]);
+  return { name, source, packed, decoded };
+}
+
+/** Every asset fallback + compact, and the Fox variants (fallback). */
+export function allCases() {
+  const cases = [];
+  for (const asset of ASSETS) {
+    cases.push(makeCase(asset, 'fallback', ['--fallback']));
+    cases.push(makeCase(asset, 'compact', ['--compact']));
+  }
+  const fox = ASSETS.find((a) => basename(a) === 'Fox.glb');
+  if (fox) for (const [tag, args] of Object.entries(FOX_VARIANTS)) cases.push(makeCase(fox, tag, args));
+  return cases;
+}
