@@ -1,0 +1,227 @@
+// render.js - what the browser tests run in Chromium: render a file with plain three.js or with
+// SkinpackGLTFPlugin (GPU or CPU decode) at fixed poses and return the pixels; decode the packed
+// words in a raw WebGL2 shader into an integer render target and read them back.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { SkinpackGLTFPlugin, skinpackData } from '/src/SkinpackGLTFPlugin.js';
+import { DECODE_GLSL, codecUniformValues, tupleTexels } from '/src/gpu.js';
+
+const SIZE = 256;
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+renderer.setPixelRatio(1);
+renderer.setSize(SIZE, SIZE);
+renderer.shadowMap.enabled = true;
+document.body.appendChild(renderer.domElement);
+
+function load(url, decode) {
+  const loader = new GLTFLoader();
+  if (decode) loader.register((parser) => new SkinpackGLTFPlugin(parser, { decode }));
+  return loader.loadAsync(url);
+}
+
+// A pose every file gets on top of its animation, so files without animations still deform.
+function pose(gltf, time) {
+  const bones = [];
+  gltf.scene.traverse((o) => { if (o.isBone) bones.push(o); });
+  bones.forEach((bone, i) => {
+    bone.rotation.x += 0.25 * Math.sin(1.7 * i + time);
+    bone.rotation.z += 0.25 * Math.cos(2.3 * i + time);
+  });
+}
+
+function stage(gltf) {
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0x303040);
+  scene.add(gltf.scene);
+  gltf.scene.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(gltf.scene); // bind-pose geometry bounds: the same for every variant
+  const center = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length();
+  const camera = new THREE.PerspectiveCamera(40, 1, size / 100, size * 10);
+  camera.position.copy(center).add(new THREE.Vector3(0.6, 0.35, 1).multiplyScalar(size * 1.25));
+  camera.lookAt(center);
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.5));
+  const light = new THREE.DirectionalLight(0xffffff, 2);
+  light.position.copy(center).add(new THREE.Vector3(size, size * 2, size));
+  light.target.position.copy(center);
+  light.castShadow = true;
+  light.shadow.mapSize.set(512, 512);
+  Object.assign(light.shadow.camera, { left: -size, right: size, top: size, bottom: -size, near: size / 100, far: size * 5 });
+  scene.add(light, light.target);
+  const ground = new THREE.Mesh(new THREE.PlaneGeometry(size * 3, size * 3), new THREE.MeshStandardMaterial({ color: 0x808080 }));
+  ground.rotation.x = -Math.PI / 2;
+  ground.position.y = box.min.y;
+  ground.receiveShadow = true;
+  scene.add(ground);
+  gltf.scene.traverse((o) => { if (o.isMesh) { o.castShadow = true; o.frustumCulled = false; } });
+  return { scene, camera };
+}
+
+function pixels() {
+  const gl = renderer.getContext();
+  const out = new Uint8Array(SIZE * SIZE * 4);
+  gl.readPixels(0, 0, SIZE, SIZE, gl.RGBA, gl.UNSIGNED_BYTE, out);
+  return out;
+}
+
+function toBase64(bytes) {
+  let text = '';
+  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
+  return btoa(text);
+}
+
+/** Renders url at each time; decode: null (plain three.js), 'gpu' or 'cpu'. */
+async function render(url, decode, times) {
+  const gltf = await load(url, decode);
+  const { scene, camera } = stage(gltf);
+  const mixer = gltf.animations.length ? new THREE.AnimationMixer(gltf.scene) : null;
+  if (mixer) mixer.clipAction(gltf.animations[0]).play();
+  const images = [], modes = [];
+  gltf.scene.traverse((o) => { if (o.userData.skinpack) modes.push(o.userData.skinpack.decode); });
+  const rest = new Map();
+  gltf.scene.traverse((o) => { if (o.isBone) rest.set(o, o.quaternion.clone()); });
+  for (const time of times) {
+    rest.forEach((q, bone) => bone.quaternion.copy(q));
+    if (mixer) mixer.setTime(time);
+    pose(gltf, time);
+    renderer.render(scene, camera);
+    images.push(toBase64(pixels()));
+  }
+  renderer.renderLists.dispose();
+  return { images, modes, size: SIZE, info: { ...renderer.info.memory } };
+}
+
+async function loadError(url, decode) {
+  try {
+    await load(url, decode);
+    return null;
+  } catch (error) {
+    return String(error && error.message ? error.message : error);
+  }
+}
+
+// ---- GPU decode read back through an integer render target -------------------------------------
+
+const READBACK_VERTEX = `#version 300 es
+precision highp float; precision highp int; precision highp usampler2D;
+in highp uint skinpackWord;
+uniform highp uint width;
+${DECODE_GLSL}
+flat out highp uvec4 vQ, vJ, vW;
+void main() {
+  highp uvec4 joints; highp vec4 weights; highp uvec4 q;
+  skinpackDecode(skinpackWord, joints, weights, q);
+  vQ = q; vJ = joints; vW = floatBitsToUint(weights);
+  uint id = uint(gl_VertexID);
+  gl_Position = vec4((float(id % width) + 0.5) / float(width) * 2.0 - 1.0, (float(id / width) + 0.5) / float(width) * 2.0 - 1.0, 0.0, 1.0);
+  gl_PointSize = 1.0;
+}`;
+const READBACK_FRAGMENT = `#version 300 es
+precision highp float; precision highp int;
+flat in highp uvec4 vQ, vJ, vW;
+layout(location = 0) out highp uvec4 outQ;
+layout(location = 1) out highp uvec4 outJ;
+layout(location = 2) out highp uvec4 outW;
+void main() { outQ = vQ; outJ = vJ; outW = vW; }`;
+
+function compile(gl, type, source) {
+  const shader = gl.createShader(type);
+  gl.shaderSource(shader, source);
+  gl.compileShader(shader);
+  if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(shader));
+  return shader;
+}
+
+/** Decodes every vertex of the first packed mesh of url in the shader; returns q, joints, weight bits. */
+function gpuDecode(codec, words, lut) {
+  const vertexCount = words.length;
+  const width = Math.ceil(Math.sqrt(vertexCount));
+  const canvas = document.createElement('canvas');
+  canvas.width = canvas.height = width;
+  const gl = canvas.getContext('webgl2');
+  const program = gl.createProgram();
+  gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, READBACK_VERTEX));
+  gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, READBACK_FRAGMENT));
+  gl.linkProgram(program);
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+  gl.useProgram(program);
+  const { texels, width: lutWidth, height: lutHeight } = tupleTexels(lut, codec.influences);
+  const texture = gl.createTexture();
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D, texture);
+  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+  gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA16UI, lutWidth, lutHeight, 0, gl.RGBA_INTEGER, gl.UNSIGNED_SHORT, texels);
+  const values = codecUniformValues(codec, lutWidth);
+  gl.uniform1i(gl.getUniformLocation(program, 'skinpackTuples'), 0);
+  gl.uniform1ui(gl.getUniformLocation(program, 'width'), width);
+  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackConfig'), values.config);
+  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackParams'), values.params);
+  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackBits'), values.bits);
+  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackAxes'), values.axes);
+  gl.uniform4fv(gl.getUniformLocation(program, 'skinpackFactors'), values.factors);
+  const buffer = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
+  gl.bufferData(gl.ARRAY_BUFFER, words, gl.STATIC_DRAW);
+  const location = gl.getAttribLocation(program, 'skinpackWord');
+  gl.enableVertexAttribArray(location);
+  gl.vertexAttribIPointer(location, 1, gl.UNSIGNED_INT, 0, 0);
+  const framebuffer = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
+  gl.activeTexture(gl.TEXTURE1); // keep the tuple table bound on unit 0
+  const targets = [0, 1, 2].map((i) => {
+    const t = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, t);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32UI, width, width);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + i, gl.TEXTURE_2D, t, 0);
+    return t;
+  });
+  gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1, gl.COLOR_ATTACHMENT2]);
+  gl.viewport(0, 0, width, width);
+  gl.drawArrays(gl.POINTS, 0, vertexCount);
+  const read = (i) => {
+    gl.readBuffer(gl.COLOR_ATTACHMENT0 + i);
+    const out = new Uint32Array(width * width * 4);
+    gl.readPixels(0, 0, width, width, gl.RGBA_INTEGER, gl.UNSIGNED_INT, out);
+    return out.subarray(0, vertexCount * 4);
+  };
+  const result = { q: read(0), joints: read(1), weightBits: read(2) };
+  targets.forEach((t) => gl.deleteTexture(t));
+  gl.getExtension('WEBGL_lose_context')?.loseContext();
+  return result;
+}
+
+/** Loads url with the plugin (CPU decode) and compares the shader's decode with the CPU's. */
+async function gpuReadback(url) {
+  const gltf = await load(url, 'cpu');
+  const results = [];
+  const seen = new Set();
+  gltf.scene.traverse((o) => {
+    const data = o.isMesh && skinpackData(o);
+    if (!data || seen.has(data)) return;
+    seen.add(data);
+    const gpu = gpuDecode(data.codec, data.words, data.lut);
+    const cpuWeightBits = new Uint32Array(data.decoded.weights.buffer);
+    let jointMismatches = 0, weightMismatches = 0, maxUlp = 0, first = null;
+    for (let i = 0; i < gpu.joints.length; ++i) {
+      if (gpu.joints[i] !== data.decoded.joints[i]) { jointMismatches++; first ??= { i, gpu: gpu.joints[i], cpu: data.decoded.joints[i] }; }
+      const ulp = Math.abs(gpu.weightBits[i] - cpuWeightBits[i]);
+      if (ulp) weightMismatches++;
+      maxUlp = Math.max(maxUlp, ulp);
+    }
+    // q is exact iff float(q) * (1/s) reproduces the decoded weights (grid methods); compare q/s in double.
+    let qMismatches = 0;
+    if (data.codec.method !== 'any') {
+      const s = Number(data.codec.scale);
+      for (let i = 0; i < gpu.q.length; ++i) {
+        if (i % 4 >= data.codec.influences) continue;
+        if (Math.fround(gpu.q[i] * (1 / s)) !== data.decoded.weights[i]) qMismatches++;
+      }
+    }
+    results.push({ mesh: o.name, method: data.codec.method, vertexCount: data.words.length, jointMismatches,
+      weightMismatches, maxUlp, qMismatches, first });
+  });
+  return results;
+}
+
+window.skinpackTest = { render, loadError, gpuReadback };
+window.skinpackTestReady = true;

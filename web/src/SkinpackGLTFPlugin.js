@@ -1,0 +1,191 @@
+// SkinpackGLTFPlugin.js - SKINPACK_packed_skin for three.js's GLTFLoader.
+//
+//   loader.register((parser) => new SkinpackGLTFPlugin(parser, { decode: 'gpu' }));
+//
+// decode: 'gpu' (default) keeps the packed words as a uint vertex attribute and the tuple table
+// as an RGBA16UI texture, and patches the materials' skinning chunks to decode per vertex;
+// codecs outside the 32-bit GPU profile fall back to the CPU path (userData.skinpack says why).
+// 'cpu' decodes into the standard skinIndex/skinWeight attributes. Both modes read fallback and
+// compact files; errors reject the load with a message naming the mesh and primitive.
+
+import {
+  BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,
+  RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
+} from 'three';
+import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from './decode.js';
+import { codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
+
+const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
+const TABLE_TYPES = ['SCALAR', 'VEC2', 'VEC3', 'VEC4'];
+
+// Per geometry: the codec, the packed arrays, the decoded skin and (fallback files) the original
+// attributes. Kept out of userData, which three.js clones through JSON.
+const DATA = new WeakMap();
+
+/** What the plugin knows about a mesh (or geometry) it decoded, or undefined. */
+export function skinpackData(meshOrGeometry) {
+  return DATA.get(meshOrGeometry.isBufferGeometry ? meshOrGeometry : meshOrGeometry.geometry);
+}
+
+function primitiveName(meshIndex, meshDef, p) {
+  return `mesh ${meshIndex}${meshDef.name ? ` "${meshDef.name}"` : ''} primitive ${p}`;
+}
+
+export class SkinpackGLTFPlugin {
+  /**
+   * @param {object} parser  GLTFParser
+   * @param {{decode?: 'gpu'|'cpu'}} [options]
+   */
+  constructor(parser, options = {}) {
+    this.name = SKINPACK_EXTENSION;
+    this.parser = parser;
+    this.decode = options.decode || 'gpu';
+    if (this.decode !== 'gpu' && this.decode !== 'cpu') throw new Error(`SkinpackGLTFPlugin: decode must be 'gpu' or 'cpu', not ${this.decode}`);
+  }
+
+  // Buffers marked as our fallback (compact mode, EXT_meshopt_compression style) have no data:
+  // their bufferViews (only JOINTS_0/WEIGHTS_0 point at them) load as zeros and are replaced.
+  loadBufferView(index) {
+    const json = this.parser.json;
+    const view = json.bufferViews[index];
+    const buffer = json.buffers[view.buffer];
+    const mark = buffer && buffer.extensions && buffer.extensions[SKINPACK_EXTENSION];
+    if (!mark || mark.fallback !== true) return null;
+    return Promise.resolve(new ArrayBuffer(view.byteLength || 0));
+  }
+
+  loadMesh(meshIndex) {
+    const meshDef = this.parser.json.meshes[meshIndex];
+    if (!meshDef.primitives.some((p) => p.extensions && p.extensions[SKINPACK_EXTENSION])) return null;
+    return this.parser.loadMesh(meshIndex).then((object) => {
+      const meshes = object.isGroup ? object.children : [object];
+      return Promise.all(meshDef.primitives.map((primitive, p) => {
+        const ext = primitive.extensions && primitive.extensions[SKINPACK_EXTENSION];
+        if (!ext) return null;
+        const where = primitiveName(meshIndex, meshDef, p);
+        return this._decodePrimitive(meshIndex, primitive, ext, where)
+          .then((packed) => this._attach(meshes[p], packed, where))
+          .catch((error) => { throw new Error(`SkinpackGLTFPlugin: ${where}: ${error.message}`); });
+      })).then(() => object);
+    });
+  }
+
+  // Reads and checks the extension's accessors and decodes every vertex (the check of the words
+  // is the decode; the GPU path keeps the words and uses the decoded values only on the CPU).
+  async _decodePrimitive(meshIndex, primitive, ext, where) {
+    const json = this.parser.json;
+    const codec = codecFromExtension(ext);
+    this._checkJointCount(meshIndex, codec);
+    const wordsDef = json.accessors[ext.vertices], tableDef = json.accessors[ext.tupleTable];
+    if (!wordsDef) throw new Error(`"vertices" = ${ext.vertices} is not an accessor`);
+    if (!tableDef) throw new Error(`"tupleTable" = ${ext.tupleTable} is not an accessor`);
+    const wordType = codec.wordsPerVertex === 1 ? 'SCALAR' : 'VEC2';
+    if (wordsDef.componentType !== COMPONENT_UNSIGNED_INT || wordsDef.type !== wordType)
+      throw new Error(`"vertices" accessor ${ext.vertices} must be UNSIGNED_INT ${wordType} for ${codec.tupleBits + codec.weightBits} bits`);
+    const tableComponent = codec.jointCount <= 256 ? COMPONENT_UNSIGNED_BYTE : COMPONENT_UNSIGNED_SHORT;
+    if (tableDef.componentType !== tableComponent || tableDef.type !== TABLE_TYPES[codec.influences - 1])
+      throw new Error(`"tupleTable" accessor ${ext.tupleTable} must be ${tableComponent === COMPONENT_UNSIGNED_BYTE ? 'UNSIGNED_BYTE' : 'UNSIGNED_SHORT'} ${TABLE_TYPES[codec.influences - 1]}`);
+    if (wordsDef.bufferView === undefined || tableDef.bufferView === undefined)
+      throw new Error('the extension\'s accessors have no bufferView');
+    const position = json.accessors[primitive.attributes.POSITION];
+    if (!position || position.count !== wordsDef.count)
+      throw new Error(`"vertices" has ${wordsDef.count} entries for ${position ? position.count : 0} vertices`);
+    const [wordsAttribute, tableAttribute] = await Promise.all([
+      this.parser.getDependency('accessor', ext.vertices), this.parser.getDependency('accessor', ext.tupleTable)]);
+    const words = wordsAttribute.array, lut = tableAttribute.array;
+    const decoded = decodeSkin(codec, words, lut);
+    return { codec, words, lut, decoded, compact: this._isCompact(primitive) };
+  }
+
+  _checkJointCount(meshIndex, codec) {
+    const json = this.parser.json;
+    for (const node of json.nodes || []) {
+      if (node.mesh !== meshIndex || node.skin === undefined) continue;
+      const joints = json.skins[node.skin].joints.length;
+      if (codec.jointCount > joints) throw new Error(`"jointCount" = ${codec.jointCount} exceeds the ${joints} joints of skin ${node.skin}`);
+    }
+  }
+
+  _isCompact(primitive) {
+    const json = this.parser.json;
+    if (primitive.attributes.JOINTS_0 === undefined) return true;
+    const accessor = json.accessors[primitive.attributes.JOINTS_0];
+    if (accessor.bufferView === undefined) return true;
+    const buffer = json.buffers[json.bufferViews[accessor.bufferView].buffer];
+    return !!(buffer.extensions && buffer.extensions[SKINPACK_EXTENSION] && buffer.extensions[SKINPACK_EXTENSION].fallback);
+  }
+
+  _attach(mesh, packed, where) {
+    if (!mesh || !mesh.isSkinnedMesh) {
+      // Not bound to a skin: nothing deforms it, the packed data is ignored (as three ignores JOINTS_0).
+      return;
+    }
+    const { codec, decoded } = packed;
+    const refusal = this.decode === 'gpu' ? gpuProfileRefusal(codec) : 'CPU decode requested';
+    const geometry = mesh.geometry;
+    const info = {
+      decode: refusal ? 'cpu' : 'gpu', reason: refusal, compact: packed.compact, method: codec.method,
+      influences: codec.influences, weightBits: codec.weightBits, tupleBits: codec.tupleBits,
+      vertexCount: decoded.vertexCount, tupleCount: packed.lut.length / codec.influences, gpuSkinBytes: 0,
+    };
+    mesh.userData.skinpack = info;
+    DATA.set(geometry, { ...packed, info, original: packed.compact ? null : {
+      skinIndex: geometry.getAttribute('skinIndex'), skinWeight: geometry.getAttribute('skinWeight') } });
+    if (refusal) {
+      if (this.decode === 'gpu') console.warn(`SkinpackGLTFPlugin: ${where}: CPU decode: ${refusal}`);
+      geometry.setAttribute('skinIndex', new BufferAttribute(decoded.joints, 4));
+      geometry.setAttribute('skinWeight', new BufferAttribute(decoded.weights, 4));
+      info.gpuSkinBytes = decoded.joints.byteLength + decoded.weights.byteLength;
+      return;
+    }
+    attachGpuSkin(mesh, packed);
+  }
+}
+
+/**
+ * Switches a skinned mesh loaded by the plugin to GPU decode: the words as a uint attribute,
+ * the tuple table as a texture, the material (and shadow materials) patched. The decoded
+ * joints/weights stay in JS memory only, for bounding spheres and raycasts.
+ */
+export function attachGpuSkin(mesh, packed) {
+  const { codec, words, lut, decoded } = packed;
+  const geometry = mesh.geometry;
+  const { texels, width, height } = tupleTexels(lut, codec.influences);
+  const texture = new DataTexture(texels, width, height, RGBAIntegerFormat, UnsignedShortType);
+  texture.internalFormat = 'RGBA16UI';
+  texture.magFilter = texture.minFilter = NearestFilter;
+  texture.generateMipmaps = false;
+  texture.needsUpdate = true;
+  const values = codecUniformValues(codec, width);
+  const uniforms = {
+    skinpackTuples: { value: texture },
+    skinpackConfig: { value: new Vector4(...values.config) }, skinpackParams: { value: new Vector4(...values.params) },
+    skinpackBits: { value: new Vector4(...values.bits) }, skinpackAxes: { value: new Vector4(...values.axes) },
+    skinpackFactors: { value: new Vector4(...values.factors) },
+  };
+  geometry.deleteAttribute('skinIndex');
+  geometry.deleteAttribute('skinWeight');
+  geometry.setAttribute('skinpackWord', new BufferAttribute(words, 1));
+  const patch = (material) => {
+    const patched = material.clone();
+    patched.onBeforeCompile = (shader) => patchSkinningShader(shader, uniforms);
+    patched.customProgramCacheKey = () => 'skinpack-gpu';
+    return patched;
+  };
+  mesh.material = Array.isArray(mesh.material) ? mesh.material.map(patch) : patch(mesh.material);
+  mesh.customDepthMaterial = patch(new MeshDepthMaterial({ depthPacking: RGBADepthPacking }));
+  mesh.customDistanceMaterial = patch(new MeshDistanceMaterial());
+  const cpuIndex = new BufferAttribute(decoded.joints, 4), cpuWeight = new BufferAttribute(decoded.weights, 4);
+  mesh.applyBoneTransform = function (index, target) {
+    const attributes = this.geometry.attributes; // attach for the call only: never uploaded
+    attributes.skinIndex = cpuIndex;
+    attributes.skinWeight = cpuWeight;
+    try {
+      return SkinnedMesh.prototype.applyBoneTransform.call(this, index, target);
+    } finally {
+      delete attributes.skinIndex;
+      delete attributes.skinWeight;
+    }
+  };
+  mesh.userData.skinpack.gpuSkinBytes = words.byteLength + texels.byteLength;
+}
