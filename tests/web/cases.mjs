@@ -2,7 +2,7 @@
 // mode, and Fox in every method and width (narrow Number path and 64-bit BigInt path), made
 // with the skinpack CLI; plus the ground truth `skinpack decompress` writes for each.
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdirSync } from 'node:fs';
+import { existsSync, mkdirSync, statSync } from 'node:fs';
 import { basename, join } from 'node:path';
 
 export const CLI = process.env.SKINPACK_CLI;
@@ -31,14 +31,21 @@ function run(args) {
   return execFileSync(CLI, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
 }
 
-/** Compresses (once per work folder) and decompresses; returns {name, source, packed, decoded}. */
+// A work file is remade when it is older than the CLI or its source.
+function stale(file, ...inputs) {
+  if (!existsSync(file)) return true;
+  const time = statSync(file).mtimeMs;
+  return inputs.some((input) => statSync(input).mtimeMs > time);
+}
+
+/** Compresses and decompresses (again when stale); returns {name, source, packed, decoded}. */
 export function makeCase(source, tag, args) {
   if (!CLI) throw new Error('SKINPACK_CLI is not set (the ctest registration sets it)');
   mkdirSync(WORK, { recursive: true });
   const name = `${basename(source, '.glb')}_${tag}`;
   const packed = join(WORK, `${name}.glb`), decoded = join(WORK, `${name}_decoded.glb`);
-  if (!existsSync(packed)) run(['compress', source, '-o', packed, ...args]);
-  if (!existsSync(decoded)) run(['decompress', packed, '-o', decoded]);
+  if (stale(packed, CLI, source)) run(['compress', source, '-o', packed, ...args]);
+  if (stale(decoded, CLI, packed)) run(['decompress', packed, '-o', decoded]);
   return { name, source, packed, decoded };
 }
 

@@ -1,0 +1,180 @@
+// browser.test.mjs - SkinpackGLTFPlugin in headless Chromium (WebGL2 on SwiftShader):
+//  * every case of cases.mjs, GPU and CPU decode, against plain three.js rendering the
+//    `skinpack decompress` output of the same file (must be pixel-identical up to rasteriser
+//    noise) and against the uncompressed original (a few pixels may differ: see ORIGINAL_*);
+//  * the shader's decode of every GPU-profile case read back from an integer render target;
+//  * compact files in the fallback-buffer layout: rejected by three.js without the plugin;
+//  * broken extension data: rejected, naming the mesh and primitive.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { copyFileSync, writeFileSync } from 'node:fs';
+import { basename, join } from 'node:path';
+import { allCases, WORK } from './cases.mjs';
+import { openTestPage, compareImages } from './browser.mjs';
+import { readGltf, writeGlb } from './gltf_file.mjs';
+import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
+
+// A channel difference of up to 2/255 is rasteriser noise (SwiftShader's float rounding of the
+// skinned positions); against the decompressed file nothing else may differ.
+const NOISE = 2;
+const DECODED_MAX_PIXELS = 0;
+// Against the original the weights differ by up to maxError (1.5e-4 to 5.2e-4 at 32 bits a
+// vertex) and the original may have more than 4 influences, which three.js ignores but the
+// compressor renormalises: a skinned position moves by at most maxError times the joint
+// offsets, a fraction of a pixel at 256 x 256, so only silhouette pixels can flip between mesh
+// and background (a large channel difference) while shading inside changes by less than
+// 16/255. At most 16 of the 65536 pixels may differ by more than that (measured: 0 to 3).
+const ORIGINAL_TOLERANCE = 16;
+const ORIGINAL_MAX_PIXELS = 16;
+const FOX_TIMES = [0.4, 1.2, 2.0, 3.1];
+const STILL_TIMES = [0.5, 1.5];
+
+const cases = allCases();
+let page;
+before(async () => { page = await openTestPage(WORK); });
+after(async () => { if (page) await page.close(); });
+
+function render(file, decode, times) {
+  return page.page.evaluate(([f, d, t]) => window.skinpackTest.render(f, d, t), [`/files/${basename(file)}`, decode, times]);
+}
+
+const references = new Map();
+async function reference(file, times) {
+  if (!references.has(file)) references.set(file, await render(file, null, times));
+  return references.get(file);
+}
+
+function originalCopy(source) {
+  const copy = join(WORK, `${basename(source, '.glb')}_original.glb`);
+  copyFileSync(source, copy);
+  return copy;
+}
+
+const narrowTags = new Set();
+for (const c of cases) {
+  const times = basename(c.source) === 'Fox.glb' ? FOX_TIMES : STILL_TIMES;
+  const atOriginalBudget = /_(fallback|compact)$/.test(c.name);
+  for (const decode of ['gpu', 'cpu']) {
+    test(`${c.name} ${decode}: renders like plain three.js on the decompressed file${atOriginalBudget ? ' and the original' : ''}`, async () => {
+      const result = await render(c.packed, decode, times);
+      assert.ok(result.modes.length > 0, 'no mesh decoded by the plugin');
+      if (decode === 'cpu') assert.ok(result.modes.every((m) => m === 'cpu'), result.modes.join());
+      if (decode === 'gpu' && result.modes.every((m) => m === 'gpu')) narrowTags.add(c.name);
+      const decoded = await reference(c.decoded, times);
+      const original = atOriginalBudget ? await reference(originalCopy(c.source), times) : null;
+      result.images.forEach((image, i) => {
+        const d = compareImages(decoded.images[i], image, NOISE);
+        assert.ok(d.differing <= DECODED_MAX_PIXELS, `t = ${times[i]}: ${d.differing} pixels differ from the decompressed file (max delta ${d.maxDelta})`);
+        if (!original) return;
+        const o = compareImages(original.images[i], image, ORIGINAL_TOLERANCE);
+        assert.ok(o.differing <= ORIGINAL_MAX_PIXELS,
+                  `t = ${times[i]}: ${o.differing} of ${o.pixels} pixels differ from the original by more than ${ORIGINAL_TOLERANCE}/255`);
+        console.log(`# ${c.name} ${decode} t=${times[i]}: vs decompressed ${d.differing} px (max delta ${d.maxDelta}), vs original ${o.differing} px > ${ORIGINAL_TOLERANCE}`);
+      });
+    });
+  }
+}
+
+test('the GPU path covers the 32-bit profile and hands wider codecs to the CPU', () => {
+  for (const tag of ['Fox_fallback', 'Fox_compact', 'Fox_fixed24', 'Fox_cube21', 'Fox_pot20', 'Fox_any22', 'Fox_k1', 'Fox_k2', 'Fox_k3'])
+    assert.ok(narrowTags.has(tag), `${tag} did not decode on the GPU`);
+  for (const tag of ['Fox_oss48', 'Fox_oss64', 'Fox_fixed64', 'Fox_any64'])
+    assert.ok(!narrowTags.has(tag), `${tag} claims GPU decode beyond 32 bits`);
+});
+
+test('the WebGL2 shader decodes every GPU-profile case exactly (integer render target)', async () => {
+  let checked = 0;
+  for (const c of cases) {
+    if (!narrowTags.has(c.name)) continue;
+    const results = await page.page.evaluate((f) => window.skinpackTest.gpuReadback(f), `/files/${basename(c.packed)}`);
+    for (const r of results) {
+      assert.equal(r.jointMismatches, 0, `${c.name} ${r.mesh}: joints differ, first ${JSON.stringify(r.first)}`);
+      assert.equal(r.qMismatches, 0, `${c.name} ${r.mesh}: grid integers differ`);
+      // Any computes w1 = 1 - sum in float on the GPU (double in C): a few ulp.
+      assert.ok(r.method === 'any' ? r.maxUlp <= 4 : r.weightMismatches === 0,
+                `${c.name} ${r.mesh}: ${r.weightMismatches} weights differ (max ${r.maxUlp} ulp)`);
+      checked += r.vertexCount;
+    }
+  }
+  assert.ok(checked > 0);
+});
+
+// ---- compact files without the plugin, broken files with it --------------------------------
+
+/** Issue 10's compact layout: JOINTS_0/WEIGHTS_0 point at bufferViews of a buffer without data
+ *  that is marked as our fallback (as EXT_meshopt_compression does). */
+function fallbackBufferLayout(compact, out) {
+  const { json, buffers } = readGltf(compact);
+  const fallback = json.buffers.length;
+  let length = 0;
+  const views = new Map();
+  for (const mesh of json.meshes) for (const primitive of mesh.primitives) {
+    if (!primitive.extensions || !primitive.extensions[SKINPACK_EXTENSION]) continue;
+    for (const name of ['JOINTS_0', 'WEIGHTS_0']) {
+      const index = primitive.attributes[name];
+      if (index === undefined || views.has(index)) continue;
+      const accessor = json.accessors[index];
+      const bytes = accessor.count * 4 * (accessor.componentType === 5126 ? 4 : accessor.componentType === 5123 ? 2 : 1);
+      views.set(index, json.bufferViews.length);
+      json.bufferViews.push({ buffer: fallback, byteOffset: length, byteLength: bytes });
+      accessor.bufferView = views.get(index);
+      length += bytes;
+    }
+  }
+  json.buffers.push({ byteLength: length, extensions: { [SKINPACK_EXTENSION]: { fallback: true } } });
+  writeGlb(out, json, buffers[0]);
+}
+
+test('compact files: plain three.js rejects the fallback-buffer layout; the plugin renders it', async () => {
+  const fox = cases.find((c) => c.name === 'Fox_compact');
+  const file = join(WORK, 'Fox_compact_fallback_buffer.glb');
+  fallbackBufferLayout(fox.packed, file);
+  const url = `/files/${basename(file)}`;
+  const refusal = await page.page.evaluate((f) => window.skinpackTest.loadError(f, null), url);
+  // three.js has no data for the marked buffer (no uri, not the GLB chunk) and fails the load.
+  assert.ok(refusal, 'three.js without the plugin loaded a compact file');
+  assert.doesNotMatch(refusal, /SkinpackGLTFPlugin/);
+  for (const decode of ['gpu', 'cpu']) {
+    const ours = await render(file, decode, FOX_TIMES), decoded = await reference(fox.decoded, FOX_TIMES);
+    ours.images.forEach((image, i) => assert.equal(compareImages(decoded.images[i], image, NOISE).differing, 0));
+  }
+});
+
+function brokenVariant(name, edit) {
+  const fox = cases.find((c) => c.name === 'Fox_fallback');
+  const { json, buffers } = readGltf(fox.packed);
+  const bin = buffers[0].slice();
+  edit(json, bin);
+  const file = join(WORK, `Fox_broken_${name}.glb`);
+  writeGlb(file, json, bin);
+  return `/files/${basename(file)}`;
+}
+
+const extOf = (json) => json.meshes[0].primitives[0].extensions[SKINPACK_EXTENSION];
+const BROKEN = {
+  weightBits: [(json) => { extOf(json).weightBits += 1; }, /"weightBits"/],
+  method: [(json) => { extOf(json).method = 'zip'; }, /unknown "method"/],
+  jointCount: [(json) => { extOf(json).jointCount = json.skins[0].joints.length + 1; }, /"jointCount"/],
+  tableType: [(json) => { json.accessors[extOf(json).tupleTable].componentType = 5123; }, /"tupleTable" accessor/],
+  wordCount: [(json) => { json.accessors[extOf(json).vertices].count -= 1; }, /entries for \d+ vertices/],
+  word: [(json, bin) => {
+    const view = json.bufferViews[json.accessors[extOf(json).vertices].bufferView];
+    new DataView(bin.buffer, bin.byteOffset).setUint32((view.byteOffset || 0) + 7 * 4, 0xffffffff, true);
+  }, /vertex 7: /],
+  tableEntry: [(json, bin) => {
+    const accessor = json.accessors[extOf(json).tupleTable];
+    bin[(json.bufferViews[accessor.bufferView].byteOffset || 0) + 1] = extOf(json).jointCount;
+  }, /tuple table entry 0 has joint/],
+};
+
+for (const [name, [edit, pattern]] of Object.entries(BROKEN)) {
+  test(`broken ${name}: the load is rejected naming mesh and primitive`, async () => {
+    const url = brokenVariant(name, edit);
+    for (const decode of ['gpu', 'cpu']) {
+      const message = await page.page.evaluate(([f, d]) => window.skinpackTest.loadError(f, d), [url, decode]);
+      assert.ok(message, `${decode}: a broken file loaded`);
+      assert.match(message, /^SkinpackGLTFPlugin: mesh 0 "fox1" primitive 0: /);
+      assert.match(message, pattern);
+    }
+  });
+}
