@@ -25,6 +25,7 @@ export const FOX_VARIANTS = {
   k2: ['--max-influences', '2', '--vertex-bits', '24'],
   k3: ['--max-influences', '3', '--vertex-bits', '32'],
   k3w: ['--max-influences', '3', '--vertex-bits', '62'],
+  meshlets: ['--meshlets'], // meshlet data is ignored
 };
 
 function run(args) {

@@ -143,6 +143,20 @@ export class SkinpackGLTFPlugin {
 }
 
 /**
+ * A copy of material that skins from the packed words of mesh (which the plugin set up for GPU
+ * decode), for materials an application assigns after loading. Any material whose vertex
+ * shader includes three's skinning chunks works.
+ */
+export function skinpackMaterial(mesh, material) {
+  const data = skinpackData(mesh);
+  if (!data || !data.uniforms) throw new Error('skinpackMaterial: the mesh does not use GPU decode');
+  const patched = material.clone();
+  patched.onBeforeCompile = (shader) => patchSkinningShader(shader, data.uniforms);
+  patched.customProgramCacheKey = () => 'skinpack-gpu';
+  return patched;
+}
+
+/**
  * Switches a skinned mesh loaded by the plugin to GPU decode: the words as a uint attribute,
  * the tuple table as a texture, the material (and shadow materials) patched. The decoded
  * joints/weights stay in JS memory only, for bounding spheres and raycasts.
@@ -166,12 +180,8 @@ export function attachGpuSkin(mesh, packed) {
   geometry.deleteAttribute('skinIndex');
   geometry.deleteAttribute('skinWeight');
   geometry.setAttribute('skinpackWord', new BufferAttribute(words, 1));
-  const patch = (material) => {
-    const patched = material.clone();
-    patched.onBeforeCompile = (shader) => patchSkinningShader(shader, uniforms);
-    patched.customProgramCacheKey = () => 'skinpack-gpu';
-    return patched;
-  };
+  DATA.get(geometry).uniforms = uniforms;
+  const patch = (material) => skinpackMaterial(mesh, material);
   mesh.material = Array.isArray(mesh.material) ? mesh.material.map(patch) : patch(mesh.material);
   mesh.customDepthMaterial = patch(new MeshDepthMaterial({ depthPacking: RGBADepthPacking }));
   mesh.customDistanceMaterial = patch(new MeshDistanceMaterial());
