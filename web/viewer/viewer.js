@@ -103,9 +103,10 @@ function row(label, value, dim = false) {
 function renderStats(list) {
   $('meshes').innerHTML = list.map((s) => {
     const path = s.data ? s.data.info.decode : 'plain';
-    const tag = `<span class="tag ${path}">${s.data ? `${path.toUpperCase()} decode` : 'not packed'}</span>`;
+    const label = s.data ? `${path.toUpperCase()} decode` : s.ext ? 'original weights' : 'not packed';
+    const tag = `<span class="tag ${path}">${label}</span>`;
     const lines = [row('vertices', s.vertices.toLocaleString())];
-    if (s.ext) {
+    if (s.data) {
       lines.push(row('codec', `${s.ext.method} n=${s.ext.n}, K=${s.ext.influences}, ${s.ext.weightBits}+${s.ext.tupleBits} bits`));
       lines.push(row('bits / vertex', `${s.beforeBits.toFixed(1)} → <b>${s.afterBits.toFixed(1)}</b>`));
       lines.push(row('max weight error', s.error ? `${s.error.max.toExponential(2)} <span class="dim">(bound ${s.bound.toExponential(2)})</span>`
@@ -245,11 +246,13 @@ function tick() {
   }
   controls.update();
   renderer.render(scene, camera);
-  if (++frames % 30 === 0) {
+  ++frames;
+  if (now - last > 500) {
     const info = renderer.info;
-    $('renderer').textContent = `${((30 * 1000) / (now - last)).toFixed(1)} fps   ${info.render.calls} draws   ${info.render.triangles.toLocaleString()} triangles\n` +
+    $('renderer').textContent = `${((frames * 1000) / (now - last)).toFixed(1)} fps   ${info.render.calls} draws   ${info.render.triangles.toLocaleString()} triangles\n` +
       `${info.memory.geometries} geometries   ${info.memory.textures} textures\n${renderer.capabilities.isWebGL2 ? 'WebGL2' : 'WebGL'}`;
     last = now;
+    frames = 0;
   }
   requestAnimationFrame(tick);
 }
@@ -258,6 +261,6 @@ requestAnimationFrame(tick);
 window.skinpackViewer = { state, show, openBuffer };
 if (params.get('file')) {
   fetch(params.get('file')).then((r) => { if (!r.ok) throw new Error(`${params.get('file')}: HTTP ${r.status}`); return r.arrayBuffer(); })
-    .then((b) => openBuffer(b, params.get('file').split('/').pop())).then(() => { state.time = Number(params.get('time') || 0); state.mixer?.setTime(state.time); })
+    .then((b) => openBuffer(b, params.get('file').split('/').pop())).then(() => { state.time = Number(params.get('time') || 0); state.mixer?.setTime(state.time); $('time').value = state.time; })
     .catch((e) => setStatus(String(e.message || e), true));
 }
