@@ -13,6 +13,8 @@ import { allCases, WORK } from './cases.mjs';
 import { openTestPage, compareImages } from './browser.mjs';
 import { readGltf, writeGlb } from './gltf_file.mjs';
 import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
+import { gpuProfileRefusal } from '../../web/src/gpu.js';
+import { readVectors } from './conformance.mjs';
 
 // A channel difference of up to 2/255 is rasteriser noise (SwiftShader's float rounding of the
 // skinned positions); against the decompressed file nothing else may differ.
@@ -97,6 +99,28 @@ test('the WebGL2 shader decodes every GPU-profile case exactly (integer render t
     }
   }
   assert.ok(checked > 0);
+});
+
+const vectors = readVectors();
+test('every conformance vector of the 32-bit GPU profile decodes exactly in the WebGL2 shader', { skip: !vectors && 'no docs/extension/conformance' }, async () => {
+  const groups = new Map();
+  let outside = 0;
+  for (const { vector, ext, codec } of vectors) {
+    if (!vector.valid) continue; // rejecting codes is a load-time (CPU) step, spec 1.0
+    if (gpuProfileRefusal(codec)) { outside++; continue; }
+    const key = JSON.stringify(ext);
+    if (!groups.has(key)) groups.set(key, { ext, codes: [], grids: [], weights: [] });
+    const group = groups.get(key);
+    group.codes.push(vector.code);
+    group.grids.push(vector.grid.map(Number));
+    group.weights.push(vector.weights);
+  }
+  const result = await page.page.evaluate((g) => window.skinpackTest.gpuConformance(g), [...groups.values()]);
+  console.log(`# GPU conformance: ${result.total} weights of ${groups.size} codecs, ${result.exactWeights} bit-exact, ` +
+              `max |dw| ${result.maxWeightError}; ${outside} valid vectors outside the 32-bit profile (CPU path)`);
+  assert.equal(result.mismatchCount, 0, result.mismatches.join('\n'));
+  assert.ok(result.maxWeightError <= 1e-6, `weights off by ${result.maxWeightError}`);
+  assert.ok(result.total > 500);
 });
 
 // ---- compact files without the plugin, broken files with it --------------------------------

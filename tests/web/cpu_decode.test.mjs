@@ -4,7 +4,9 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readGltf, readAccessor } from './gltf_file.mjs';
 import { allCases, ASSETS } from './cases.mjs';
-import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from '../../web/src/decode.js';
+import { codecFromExtension, decodeSkin, decodeWeightCode, SKINPACK_EXTENSION } from '../../web/src/decode.js';
+import { CONFORMANCE, float32Hex, readVectors } from './conformance.mjs';
+import { readdirSync, readFileSync } from 'node:fs';
 
 function packedPrimitives(file) {
   const out = [];
@@ -84,4 +86,50 @@ test('bad words and tables are refused, naming the vertex', () => {
   const badLut = lut.slice(); badLut[2] = ext.jointCount;
   assert.throws(() => decodeSkin(codec, words, badLut), /tuple table entry 0 has joint/);
   assert.throws(() => decodeSkin(codec, words, lut.subarray(0, ext.influences)), /"tupleBits"/);
+});
+
+// ---- spec 1.0 conformance ---------------------------------------------------------------------
+
+const vectors = readVectors();
+test('every conformance vector decodes exactly (integers and float32 bits) or is rejected', { skip: !vectors && 'no docs/extension/conformance' }, () => {
+  let valid = 0, invalid = 0;
+  for (const { vector, codec, code } of vectors) {
+    const weights = new Float32Array(4), grid = [];
+    const ok = decodeWeightCode(codec, code, weights, 0, grid);
+    const label = `${vector.method} K=${vector.influences} n=${vector.n} code ${vector.code}`;
+    assert.equal(ok, vector.valid, `${label}: ${vector.valid ? 'rejected' : `accepted (${vector.reason})`}`);
+    if (!ok) { invalid++; continue; }
+    assert.deepEqual(grid.map(String), vector.grid, `${label}: integers`);
+    assert.deepEqual(Array.from(weights.subarray(0, vector.influences), float32Hex), vector.weights, `${label}: weights`);
+    valid++;
+  }
+  assert.ok(valid > 1000 && invalid > 100, `${valid} valid, ${invalid} invalid vectors`);
+});
+
+test('the conformance example files decode to their expected joints and weights', { skip: !vectors && 'no examples' }, () => {
+  const folder = `${CONFORMANCE}examples/`;
+  const examples = readdirSync(folder).filter((f) => f.endsWith('.json'));
+  assert.ok(examples.length >= 3);
+  for (const name of examples) {
+    const expected = JSON.parse(readFileSync(folder + name, 'utf8'));
+    const file = readGltf(folder + name.replace(/\.json$/, '.glb'));
+    for (const primitive of expected.primitives) {
+      const ext = file.json.meshes[primitive.mesh].primitives[primitive.primitive].extensions[SKINPACK_EXTENSION];
+      const { joints, weights } = decodePrimitive(file, ext);
+      const k = ext.influences;
+      primitive.joints.forEach((slots, v) => {
+        assert.deepEqual(Array.from(joints.subarray(4 * v, 4 * v + k)), slots, `${name} vertex ${v}: joints`);
+        assert.deepEqual(Array.from(weights.subarray(4 * v, 4 * v + k), float32Hex), primitive.weights[v], `${name} vertex ${v}: weights`);
+      });
+    }
+  }
+});
+
+test('large integers: strings above 2^53 only', () => {
+  const base = { vertices: 0, tupleTable: 0, influences: 2, jointCount: 1, method: 'oss', tupleBits: 0 };
+  assert.equal(codecFromExtension({ ...base, n: '9223372036854775808', weightBits: 63 }).nBig, 2n ** 63n);
+  assert.throws(() => codecFromExtension({ ...base, n: '1063', weightBits: 11 }), /"n" = "1063"/);
+  assert.throws(() => codecFromExtension({ ...base, n: 2 ** 60, weightBits: 60 }), /"n" = \d+ must be an integer 0..2\^53/);
+  assert.throws(() => codecFromExtension({ ...base, n: '18446744073709551616', weightBits: 64 }), /"n"/);
+  assert.throws(() => codecFromExtension({ ...base, n: 1063, weightBits: 11, axisSamples: [2] }), /"axisSamples" must be absent/);
 });

@@ -35,6 +35,24 @@ function isInteger(value, low, high) {
   return Number.isInteger(value) && value >= low && value <= high;
 }
 
+const TWO_53 = 2n ** 53n, MAX_U64 = 2n ** 64n - 1n;
+
+/**
+ * A non-negative integer property that may exceed 2^53 (spec 1.0, "Large integers"): a JSON
+ * number up to 2^53, or a string of decimal digits for a value above 2^53 (at most 2^64 - 1).
+ */
+export function parseLargeInteger(value, field) {
+  if (typeof value === 'number') {
+    if (!Number.isInteger(value) || value < 0 || value > Number(TWO_53)) fail(`${field} = ${value} must be an integer 0..2^53 (larger values are strings)`);
+    return BigInt(value);
+  }
+  if (typeof value === 'string' && /^[1-9][0-9]*$/.test(value)) {
+    const big = BigInt(value);
+    if (big > TWO_53 && big <= MAX_U64) return big;
+  }
+  fail(`${field} = ${JSON.stringify(value)} must be an integer (a decimal string only above 2^53, at most 2^64 - 1)`);
+}
+
 /** ceil(log2(count)) for count >= 1 (sp_index_bits); count may be a Number or a BigInt. */
 export function indexBits(count) {
   let bits = 0;
@@ -78,8 +96,9 @@ function gridComponentBits(method, slot, m) {
   return m - drop;
 }
 
-function configureGrid(codec, method, k, m) {
-  if (!isInteger(m, method === 'pot' ? 2 : 1, 64)) fail(`"n" = ${m} is not a valid m for ${method}`);
+function configureGrid(codec, method, k, big) {
+  const m = Number(big);
+  if (big > 64n || !isInteger(m, method === 'pot' ? 2 : 1, 64)) fail(`"n" = ${big} is not a valid m for ${method}`);
   const first = method === 'fixed' ? 0 : 1;
   let total = 0;
   for (let slot = first; slot < k; ++slot) {
@@ -94,10 +113,10 @@ function configureGrid(codec, method, k, m) {
 }
 
 function configureOss(codec, k, n) {
-  if (!Number.isSafeInteger(n) || n < 2) fail(`"n" = ${n} is not a valid N for oss`);
-  const count = ossCodeCount(BigInt(n), k);
+  if (n < 2n) fail(`"n" = ${n} is not a valid N for oss`);
+  const count = ossCodeCount(n, k);
   if (count - 1n >= 1n << 64n) fail(`"n" = ${n} gives codes over 64 bits for ${k} influences`);
-  codec.scale = 2n * BigInt(n - 1);
+  codec.scale = 2n * (n - 1n);
   codec.maxCode = count - 1n;
   codec.maxError = (k - 1) / (k * Number(codec.scale));
 }
@@ -107,12 +126,13 @@ function configureAny(codec, k, axisSamples) {
     fail(`"axisSamples" must list ${k - 1} sample counts for any with ${k} influences`);
   let count = 1n, w1Error = 0;
   for (let a = 0; a < k - 1; ++a) {
-    const q = axisSamples[a];
-    if (!Number.isSafeInteger(q) || q < 2) fail(`"axisSamples"[${a}] = ${q} must be an integer >= 2`);
-    count *= BigInt(q);
+    const q = parseLargeInteger(axisSamples[a], `"axisSamples"[${a}]`);
+    if (q < 2n) fail(`"axisSamples"[${a}] = ${q} must be >= 2`);
+    count *= q;
     if (count > 1n << 64n) fail('"axisSamples" give codes over 64 bits');
-    codec.axisSamples.push(BigInt(q));
-    w1Error += 1 / ((a + 2) * (q - 1)) / 2;
+    codec.axisSamples.push(q);
+    codec.axisDivisors.push((a + 2) * Number(q - 1n)); // binary64, as the reference computes it
+    w1Error += 1 / codec.axisDivisors[a] / 2;
   }
   codec.scale = 0n;
   codec.maxCode = count - 1n;
@@ -135,20 +155,23 @@ export function codecFromExtension(ext) {
   if (!METHODS.includes(method)) fail(`unknown "method" ${JSON.stringify(method)}`);
   if (!isInteger(ext.weightBits, 0, MAX_WEIGHT_BITS)) fail(`"weightBits" = ${ext.weightBits} must be 0..64`);
   if (!isInteger(ext.tupleBits, 0, MAX_TUPLE_BITS)) fail(`"tupleBits" = ${ext.tupleBits} must be 0..32`);
+  const n = parseLargeInteger(ext.n, '"n"');
   const codec = {
     method, methodId: METHODS.indexOf(method), influences: k, jointCount: ext.jointCount,
-    n: ext.n, componentBits: [], axisSamples: [], scale: 1n, maxCode: 0n, maxError: 0,
-    weightBits: ext.weightBits, tupleBits: ext.tupleBits,
+    n: Number(n), nBig: n, componentBits: [], axisSamples: [], axisDivisors: [], scale: 1n, maxCode: 0n,
+    maxError: 0, weightBits: ext.weightBits, tupleBits: ext.tupleBits,
   };
+  if (ext.axisSamples !== undefined && (method !== 'any' || k === 1))
+    fail(`"axisSamples" must be absent for ${k === 1 ? '1 influence' : method}`);
   if (k === 1) {
-    if (ext.n !== 0) fail(`"n" = ${ext.n} must be 0 for 1 influence`);
+    if (n !== 0n) fail(`"n" = ${n} must be 0 for 1 influence`);
   } else if (method === 'any') {
-    if (ext.n !== 0) fail(`"n" = ${ext.n} must be 0 for any`);
+    if (n !== 0n) fail(`"n" = ${n} must be 0 for any`);
     configureAny(codec, k, ext.axisSamples);
   } else if (method === 'oss') {
-    configureOss(codec, k, ext.n);
+    configureOss(codec, k, n);
   } else {
-    configureGrid(codec, method, k, ext.n);
+    configureGrid(codec, method, k, n);
   }
   const bits = bitWidth(codec.maxCode);
   if (bits !== ext.weightBits) fail(`"weightBits" = ${ext.weightBits} but ${method} with n = ${ext.n} has ${bits}-bit codes`);
@@ -232,35 +255,38 @@ function gridUnpackNumber(codec, code, q) {
   if (first === 1) q[0] = rest;
 }
 
-// sp_any_decode: double accumulation, float results.
-function anyDecode(codec, code, weights, offset, big) {
+// Any (spec 1.0, "Exact float result"): binary64 accumulation, binary32 results, w1 >= 0.
+function anyDecode(codec, code, weights, offset, big, grid) {
   let rest = 1;
   for (let a = 0; a + 1 < codec.influences; ++a) {
-    const samples = codec.axisNumbers[a];
     let x;
     if (big) {
-      x = Number(code % codec.axisSamples[a]);
-      code /= codec.axisSamples[a];
+      const q = codec.axisSamples[a];
+      x = code % q;
+      code /= q;
     } else {
-      x = code % samples;
-      code = Math.floor(code / samples);
+      const q = codec.axisNumbers[a];
+      x = code % q;
+      code = Math.floor(code / q);
     }
-    const w = x * (1 / ((a + 2) * (samples - 1)));
+    if (grid) grid[a] = x;
+    const w = Number(x) * (1 / codec.axisDivisors[a]);
     weights[offset + a + 1] = w;
     rest -= w;
   }
   weights[offset] = rest;
-  return Math.fround(rest) >= Math.fround(-1e-6); // decode_valid's w1 check
+  return rest >= 0;
 }
 
 // Sorted grid point summing to s (decode_valid); writes float(q * (1/s)).
-function gridToWeights(q, k, scale, weights, offset) {
+function gridToWeights(q, k, scale, weights, offset, grid) {
   let sum = 0;
   for (let i = 0; i < k; ++i) {
     if (i > 0 && q[i] > q[i - 1]) return false;
     sum += q[i];
   }
   if (sum !== scale) return false;
+  if (grid) for (let i = 0; i < k; ++i) grid[i] = q[i];
   const inverse = 1 / scale;
   for (let i = 0; i < k; ++i) weights[offset + i] = q[i] * inverse;
   return true;
@@ -313,13 +339,14 @@ function gridUnpackBig(codec, code, q) {
   if (first === 1) q[0] = rest;
 }
 
-function gridToWeightsBig(q, k, scale, weights, offset) {
+function gridToWeightsBig(q, k, scale, weights, offset, grid) {
   let sum = 0n;
   for (let i = 0; i < k; ++i) {
     if (i > 0 && q[i] > q[i - 1]) return false;
     sum += q[i];
   }
   if (sum !== scale) return false;
+  if (grid) for (let i = 0; i < k; ++i) grid[i] = q[i];
   const inverse = 1 / Number(scale);
   for (let i = 0; i < k; ++i) weights[offset + i] = Number(q[i]) * inverse;
   return true;
@@ -329,8 +356,9 @@ function gridToWeightsBig(q, k, scale, weights, offset) {
  * Decodes one weight code (Number for the Number path, else BigInt) into K weights written to
  * weights[offset ...] (a Float32Array rounds them like the C decoder). Returns false for a code
  * no encoder writes: above the code count, off the simplex or unsorted (decode_valid).
+ * grid (optional array) receives the exact integers: q1..qK, or x2..xK for Any.
  */
-export function decodeWeightCode(codec, code, weights, offset = 0) {
+export function decodeWeightCode(codec, code, weights, offset = 0, grid = null) {
   const k = codec.influences;
   const big = typeof code === 'bigint';
   if (big ? code > codec.maxCode : code > codec.maxCodeNumber) return false;
@@ -338,17 +366,17 @@ export function decodeWeightCode(codec, code, weights, offset = 0) {
     weights[offset] = 1;
     return true;
   }
-  if (codec.method === 'any') return anyDecode(codec, code, weights, offset, big);
+  if (codec.method === 'any') return anyDecode(codec, code, weights, offset, big, grid);
   if (big) {
     const q = [0n, 0n, 0n, 0n];
-    if (codec.method === 'oss') ossUnpackBig(BigInt(codec.n), k, code, q);
+    if (codec.method === 'oss') ossUnpackBig(codec.nBig, k, code, q);
     else gridUnpackBig(codec, code, q);
-    return gridToWeightsBig(q, k, codec.scale, weights, offset);
+    return gridToWeightsBig(q, k, codec.scale, weights, offset, grid);
   }
   const q = [0, 0, 0, 0];
   if (codec.method === 'oss') ossUnpackNumber(codec.n, k, code, q);
   else gridUnpackNumber(codec, code, q);
-  return gridToWeights(q, k, codec.scaleNumber, weights, offset);
+  return gridToWeights(q, k, codec.scaleNumber, weights, offset, grid);
 }
 
 // ---- whole primitives (sp_decompress_skin) ----------------------------------------------------
@@ -407,7 +435,13 @@ export function decodeSkin(codec, words, lut) {
     const offset = v * 4;
     if (!decodeWeightCode(codec, code, weights, offset))
       fail(`vertex ${v}: weight code ${code} is not a valid ${codec.method} code`, v);
-    for (let s = 0; s < k; ++s) joints[offset + s] = weights[offset + s] > 0 ? lut[tuple * k + s] : 0;
+    for (let s = 0; s < k; ++s) {
+      const joint = lut[tuple * k + s];
+      if (!(weights[offset + s] > 0)) continue;
+      for (let t = 0; t < s; ++t)
+        if (joints[offset + t] === joint && weights[offset + t] > 0) fail(`vertex ${v}: joint ${joint} carries weight in two slots`, v);
+      joints[offset + s] = joint;
+    }
   }
   return { joints, weights, vertexCount };
 }

@@ -22,6 +22,7 @@ export function gpuProfileRefusal(codec) {
     if (codec.maxCodeNumber > limit) return `oss K = ${codec.influences} codes above ${limit} overflow 32-bit math`;
   }
   if (codec.scale >= 2n ** 32n) return 'grid denominator over 32 bits';
+  if (codec.axisSamples.some((q) => q >= 2n ** 32n)) return 'any axis sample counts over 32 bits';
   return null;
 }
 

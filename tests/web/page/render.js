@@ -5,6 +5,7 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { SkinpackGLTFPlugin, skinpackData } from '/src/SkinpackGLTFPlugin.js';
 import { DECODE_GLSL, codecUniformValues, tupleTexels } from '/src/gpu.js';
+import { codecFromExtension } from '/src/decode.js';
 
 const SIZE = 256;
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
@@ -131,23 +132,31 @@ function compile(gl, type, source) {
   return shader;
 }
 
-/** Decodes every vertex of the first packed mesh of url in the shader; returns q, joints, weight bits. */
-function gpuDecode(codec, words, lut) {
-  const vertexCount = words.length;
-  const width = Math.ceil(Math.sqrt(vertexCount));
+let readback = null; // one WebGL2 context and program for every read-back
+
+function readbackContext() {
+  if (readback) return readback;
   const canvas = document.createElement('canvas');
-  canvas.width = canvas.height = width;
   const gl = canvas.getContext('webgl2');
   const program = gl.createProgram();
   gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, READBACK_VERTEX));
   gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, READBACK_FRAGMENT));
   gl.linkProgram(program);
   if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+  readback = { gl, program, table: gl.createTexture(), words: gl.createBuffer(), framebuffer: gl.createFramebuffer(),
+               targets: [0, 1, 2].map(() => gl.createTexture()) };
+  return readback;
+}
+
+/** Decodes words (one a vertex) with tuple table lut in the shader; returns q, joints, weight bits. */
+function gpuDecode(codec, words, lut) {
+  const { gl, program, table, words: buffer, framebuffer, targets } = readbackContext();
+  const vertexCount = words.length;
+  const width = Math.max(1, Math.ceil(Math.sqrt(vertexCount)));
   gl.useProgram(program);
   const { texels, width: lutWidth, height: lutHeight } = tupleTexels(lut, codec.influences);
-  const texture = gl.createTexture();
   gl.activeTexture(gl.TEXTURE0);
-  gl.bindTexture(gl.TEXTURE_2D, texture);
+  gl.bindTexture(gl.TEXTURE_2D, table);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
   gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA16UI, lutWidth, lutHeight, 0, gl.RGBA_INTEGER, gl.UNSIGNED_SHORT, texels);
@@ -159,21 +168,17 @@ function gpuDecode(codec, words, lut) {
   gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackBits'), values.bits);
   gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackAxes'), values.axes);
   gl.uniform4fv(gl.getUniformLocation(program, 'skinpackFactors'), values.factors);
-  const buffer = gl.createBuffer();
   gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
   gl.bufferData(gl.ARRAY_BUFFER, words, gl.STATIC_DRAW);
   const location = gl.getAttribLocation(program, 'skinpackWord');
   gl.enableVertexAttribArray(location);
   gl.vertexAttribIPointer(location, 1, gl.UNSIGNED_INT, 0, 0);
-  const framebuffer = gl.createFramebuffer();
   gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
   gl.activeTexture(gl.TEXTURE1); // keep the tuple table bound on unit 0
-  const targets = [0, 1, 2].map((i) => {
-    const t = gl.createTexture();
+  targets.forEach((t, i) => {
     gl.bindTexture(gl.TEXTURE_2D, t);
-    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32UI, width, width);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32UI, width, width, 0, gl.RGBA_INTEGER, gl.UNSIGNED_INT, null);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + i, gl.TEXTURE_2D, t, 0);
-    return t;
   });
   gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1, gl.COLOR_ATTACHMENT2]);
   gl.viewport(0, 0, width, width);
@@ -184,10 +189,35 @@ function gpuDecode(codec, words, lut) {
     gl.readPixels(0, 0, width, width, gl.RGBA_INTEGER, gl.UNSIGNED_INT, out);
     return out.subarray(0, vertexCount * 4);
   };
-  const result = { q: read(0), joints: read(1), weightBits: read(2) };
-  targets.forEach((t) => gl.deleteTexture(t));
-  gl.getExtension('WEBGL_lose_context')?.loseContext();
-  return result;
+  return { q: read(0), joints: read(1), weightBits: read(2) };
+}
+
+/**
+ * Conformance vectors in the shader: groups of {ext, codes, grids, weights} (one codec each,
+ * valid codes of the 32-bit profile). Integers must be exact; returns the mismatches and the
+ * largest weight difference from the binary64 reference.
+ */
+function gpuConformance(groups) {
+  const mismatches = [];
+  let maxWeightError = 0, exactWeights = 0, total = 0;
+  const float = new Float32Array(1), bits = new Uint32Array(float.buffer);
+  for (const group of groups) {
+    const codec = codecFromExtension(group.ext), k = codec.influences;
+    const gpu = gpuDecode(codec, new Uint32Array(group.codes.map(Number)), new Uint8Array(k));
+    group.codes.forEach((code, c) => {
+      const grid = k === 1 ? [] : codec.method === 'any' ? Array.from(gpu.q.subarray(4 * c + 1, 4 * c + k)) : Array.from(gpu.q.subarray(4 * c, 4 * c + k));
+      if (grid.join() !== group.grids[c].join()) mismatches.push(`${group.ext.method} K=${k} n=${group.ext.n} code ${code}: ${grid} != ${group.grids[c]}`);
+      for (let s = 0; s < k; ++s) {
+        bits[0] = gpu.weightBits[4 * c + s];
+        const ours = float[0];
+        bits[0] = parseInt(group.weights[c][s], 16);
+        maxWeightError = Math.max(maxWeightError, Math.abs(ours - float[0]));
+        if (gpu.weightBits[4 * c + s] === bits[0]) exactWeights++;
+        total++;
+      }
+    });
+  }
+  return { mismatches: mismatches.slice(0, 10), mismatchCount: mismatches.length, maxWeightError, exactWeights, total };
 }
 
 /** Loads url with the plugin (CPU decode) and compares the shader's decode with the CPU's. */
@@ -223,5 +253,5 @@ async function gpuReadback(url) {
   return results;
 }
 
-window.skinpackTest = { render, loadError, gpuReadback };
+window.skinpackTest = { render, loadError, gpuReadback, gpuConformance };
 window.skinpackTestReady = true;
