@@ -43,6 +43,25 @@ export class SkinpackGLTFPlugin {
     if (this.decode !== 'gpu' && this.decode !== 'cpu') throw new Error(`SkinpackGLTFPlugin: decode must be 'gpu' or 'cpu', not ${this.decode}`);
   }
 
+  // Primitives sharing the packed words must declare the same properties (spec 1.0, Accessors).
+  beforeRoot() {
+    const seen = new Map();
+    const meshes = this.parser.json.meshes || [];
+    for (let m = 0; m < meshes.length; ++m) {
+      for (let p = 0; p < meshes[m].primitives.length; ++p) {
+        const ext = meshes[m].primitives[p].extensions && meshes[m].primitives[p].extensions[SKINPACK_EXTENSION];
+        if (!ext) continue;
+        const { meshlets, ...properties } = ext;
+        const key = JSON.stringify(properties, Object.keys(properties).sort());
+        const first = seen.get(ext.vertices);
+        if (first && first.key !== key)
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${primitiveName(m, meshes[m], p)}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
+        if (!first) seen.set(ext.vertices, { key, where: primitiveName(m, meshes[m], p) });
+      }
+    }
+    return null;
+  }
+
   // Buffers marked as our fallback (compact mode, EXT_meshopt_compression style) have no data:
   // their bufferViews (only JOINTS_0/WEIGHTS_0 point at them) load as zeros and are replaced.
   loadBufferView(index) {
@@ -143,6 +162,34 @@ export class SkinpackGLTFPlugin {
 }
 
 /**
+ * The class of GPU-decoded meshes. Bounding volumes and raycasts skin on the CPU from the
+ * decoded values kept in JS memory (attached for the call only, never uploaded); copies keep
+ * the patched shadow materials.
+ */
+export class SkinpackSkinnedMesh extends SkinnedMesh {
+  applyBoneTransform(index, target) {
+    const data = DATA.get(this.geometry);
+    if (!data || !data.cpuSkin) return super.applyBoneTransform(index, target);
+    const attributes = this.geometry.attributes;
+    attributes.skinIndex = data.cpuSkin.skinIndex;
+    attributes.skinWeight = data.cpuSkin.skinWeight;
+    try {
+      return super.applyBoneTransform(index, target);
+    } finally {
+      delete attributes.skinIndex;
+      delete attributes.skinWeight;
+    }
+  }
+
+  copy(source, recursive) {
+    super.copy(source, recursive);
+    this.customDepthMaterial = source.customDepthMaterial;
+    this.customDistanceMaterial = source.customDistanceMaterial;
+    return this;
+  }
+}
+
+/**
  * A copy of material that skins from the packed words of mesh (which the plugin set up for GPU
  * decode), for materials an application assigns after loading. Any material whose vertex
  * shader includes three's skinning chunks works.
@@ -185,17 +232,7 @@ export function attachGpuSkin(mesh, packed) {
   mesh.material = Array.isArray(mesh.material) ? mesh.material.map(patch) : patch(mesh.material);
   mesh.customDepthMaterial = patch(new MeshDepthMaterial({ depthPacking: RGBADepthPacking }));
   mesh.customDistanceMaterial = patch(new MeshDistanceMaterial());
-  const cpuIndex = new BufferAttribute(decoded.joints, 4), cpuWeight = new BufferAttribute(decoded.weights, 4);
-  mesh.applyBoneTransform = function (index, target) {
-    const attributes = this.geometry.attributes; // attach for the call only: never uploaded
-    attributes.skinIndex = cpuIndex;
-    attributes.skinWeight = cpuWeight;
-    try {
-      return SkinnedMesh.prototype.applyBoneTransform.call(this, index, target);
-    } finally {
-      delete attributes.skinIndex;
-      delete attributes.skinWeight;
-    }
-  };
+  DATA.get(geometry).cpuSkin = { skinIndex: new BufferAttribute(decoded.joints, 4), skinWeight: new BufferAttribute(decoded.weights, 4) };
+  Object.setPrototypeOf(mesh, SkinpackSkinnedMesh.prototype); // clones (SkeletonUtils.clone, .clone()) stay GPU-decoded too
   mesh.userData.skinpack.gpuSkinBytes = words.byteLength + texels.byteLength;
 }

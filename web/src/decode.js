@@ -182,10 +182,19 @@ export function codecFromExtension(ext) {
   codec.scaleNumber = Number(codec.scale);
   codec.maxCodeNumber = Number(codec.maxCode);
   codec.axisNumbers = codec.axisSamples.map(Number);
+  let shift = 0; // grid fields: shift, 2^shift and 2^bits for the Number path
+  codec.fields = codec.componentBits.map((bits) => {
+    const field = { shift, scale: 2 ** shift, range: 2 ** bits, mask: bits >= 32 ? 0xffffffff : 2 ** bits - 1 };
+    shift += bits;
+    return field;
+  });
+  codec.code32 = codec.maxCode < 2n ** 32n;
   return codec;
 }
 
 // ---- weight decoders, Number path -----------------------------------------------------------
+
+const GRID = new Float64Array(4); // scratch integers of the Number path (exact below 2^53)
 
 function rowBaseNumber(n, j) {
   return Math.floor((4 * j * n + 2 * j + 1 - 3 * j * j) / 4);
@@ -244,12 +253,11 @@ function ossUnpackNumber(n, k, code, q) {
 }
 
 function gridUnpackNumber(codec, code, q) {
-  let shift = 0, rest = codec.scaleNumber;
-  const first = codec.method === 'fixed' ? 0 : 1;
+  let rest = codec.scaleNumber;
+  const first = codec.method === 'fixed' ? 0 : 1, fields = codec.fields, code32 = codec.code32;
   for (let i = first, c = 0; i < codec.influences; ++i, ++c) {
-    const bits = codec.componentBits[c];
-    q[i] = Math.floor(code / 2 ** shift) % 2 ** bits;
-    shift += bits;
+    const field = fields[c];
+    q[i] = code32 ? ((code >>> field.shift) & field.mask) >>> 0 : Math.floor(code / field.scale) % field.range;
     if (i > 0) rest = rest >= q[i] ? rest - q[i] : 0;
   }
   if (first === 1) q[0] = rest;
@@ -373,7 +381,8 @@ export function decodeWeightCode(codec, code, weights, offset = 0, grid = null) 
     else gridUnpackBig(codec, code, q);
     return gridToWeightsBig(q, k, codec.scale, weights, offset, grid);
   }
-  const q = [0, 0, 0, 0];
+  const q = GRID;
+  q[0] = q[1] = q[2] = q[3] = 0;
   if (codec.method === 'oss') ossUnpackNumber(codec.n, k, code, q);
   else gridUnpackNumber(codec, code, q);
   return gridToWeights(q, k, codec.scaleNumber, weights, offset, grid);
@@ -386,6 +395,48 @@ function splitValue(codec, words, v) {
   const low = words[2 * v], high = words[2 * v + 1];
   if (codec.number) return high * TWO_32 + low;
   return (BigInt(high) << 32n) | BigInt(low);
+}
+
+// Writes the joints of vertex v (zero-weight slots keep joint 0); a joint may carry weight once.
+function writeJoints(k, lut, tuple, joints, weights, offset, v) {
+  for (let s = 0; s < k; ++s) {
+    if (!(weights[offset + s] > 0)) continue;
+    const joint = lut[tuple * k + s];
+    for (let t = 0; t < s; ++t)
+      if (joints[offset + t] === joint && weights[offset + t] > 0) fail(`vertex ${v}: joint ${joint} carries weight in two slots`, v);
+    joints[offset + s] = joint;
+  }
+}
+
+// One 32-bit word a vertex: integer operations only.
+function decodeWords32(codec, words, lut, lutSize, joints, weights) {
+  const k = codec.influences, weightBits = codec.weightBits, valueBits = codec.tupleBits + weightBits;
+  const codeMask = weightBits >= 32 ? 0xffffffff : 2 ** weightBits - 1;
+  for (let v = 0; v < words.length; ++v) {
+    const value = words[v];
+    if (valueBits < 32 && value >>> valueBits !== 0) fail(`vertex ${v}: bits set above tupleBits + weightBits = ${valueBits}`, v);
+    const code = (value & codeMask) >>> 0, tuple = weightBits >= 32 ? 0 : value >>> weightBits;
+    if (tuple >= lutSize) fail(`vertex ${v}: tuple index ${tuple} >= tuple table size ${lutSize}`, v);
+    if (!decodeWeightCode(codec, code, weights, v * 4)) fail(`vertex ${v}: weight code ${code} is not a valid ${codec.method} code`, v);
+    writeJoints(k, lut, tuple, joints, weights, v * 4, v);
+  }
+}
+
+// Two words a vertex: Number arithmetic below 2^53, BigInt above.
+function decodeWordsWide(codec, words, lut, lutSize, joints, weights) {
+  const k = codec.influences, valueBits = codec.tupleBits + codec.weightBits, wide = !codec.number;
+  const vertexCount = words.length / codec.wordsPerVertex;
+  const limit = wide ? 1n << BigInt(valueBits) : 2 ** valueBits;
+  const codeRange = wide ? 1n << BigInt(codec.weightBits) : 2 ** codec.weightBits;
+  for (let v = 0; v < vertexCount; ++v) {
+    const value = splitValue(codec, words, v);
+    if (value >= limit) fail(`vertex ${v}: bits set above tupleBits + weightBits = ${valueBits}`, v);
+    const code = value % codeRange;
+    const tuple = wide ? Number(value / codeRange) : Math.floor(value / codeRange);
+    if (tuple >= lutSize) fail(`vertex ${v}: tuple index ${tuple} >= tuple table size ${lutSize}`, v);
+    if (!decodeWeightCode(codec, code, weights, v * 4)) fail(`vertex ${v}: weight code ${code} is not a valid ${codec.method} code`, v);
+    writeJoints(k, lut, tuple, joints, weights, v * 4, v);
+  }
 }
 
 /**
@@ -422,27 +473,8 @@ export function decodeSkin(codec, words, lut) {
   const lutSize = checkTupleTable(codec, lut);
   const joints = new Uint16Array(vertexCount * 4);
   const weights = new Float32Array(vertexCount * 4);
-  const valueBits = codec.tupleBits + codec.weightBits;
-  const limit = codec.number ? 2 ** valueBits : 1n << BigInt(valueBits);
-  const codeRange = codec.number ? 2 ** codec.weightBits : 1n << BigInt(codec.weightBits);
-  const wide = !codec.number;
-  for (let v = 0; v < vertexCount; ++v) {
-    const value = splitValue(codec, words, v);
-    if (value >= limit) fail(`vertex ${v}: bits set above tupleBits + weightBits = ${valueBits}`, v);
-    const code = value % codeRange;
-    const tuple = wide ? Number(value / codeRange) : Math.floor(value / codeRange);
-    if (tuple >= lutSize) fail(`vertex ${v}: tuple index ${tuple} >= tuple table size ${lutSize}`, v);
-    const offset = v * 4;
-    if (!decodeWeightCode(codec, code, weights, offset))
-      fail(`vertex ${v}: weight code ${code} is not a valid ${codec.method} code`, v);
-    for (let s = 0; s < k; ++s) {
-      const joint = lut[tuple * k + s];
-      if (!(weights[offset + s] > 0)) continue;
-      for (let t = 0; t < s; ++t)
-        if (joints[offset + t] === joint && weights[offset + t] > 0) fail(`vertex ${v}: joint ${joint} carries weight in two slots`, v);
-      joints[offset + s] = joint;
-    }
-  }
+  if (per === 1 && codec.number) decodeWords32(codec, words, lut, lutSize, joints, weights);
+  else decodeWordsWide(codec, words, lut, lutSize, joints, weights);
   return { joints, weights, vertexCount };
 }
 

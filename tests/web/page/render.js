@@ -70,9 +70,13 @@ function toBase64(bytes) {
   return btoa(text);
 }
 
-/** Renders url at each time; decode: null (plain three.js), 'gpu' or 'cpu'. */
-async function render(url, decode, times) {
+/** Renders url at each time; decode: null (plain three.js), 'gpu' or 'cpu'; copy: render a SkeletonUtils clone. */
+async function render(url, decode, times, copy = false) {
   const gltf = await load(url, decode);
+  if (copy) {
+    const { clone } = await import('three/addons/utils/SkeletonUtils.js');
+    gltf.scene = clone(gltf.scene);
+  }
   const { scene, camera } = stage(gltf);
   const mixer = gltf.animations.length ? new THREE.AnimationMixer(gltf.scene) : null;
   if (mixer) mixer.clipAction(gltf.animations[0]).play();
@@ -253,5 +257,60 @@ async function gpuReadback(url) {
   return results;
 }
 
-window.skinpackTest = { render, loadError, gpuReadback, gpuConformance };
+// ---- benchmark: many animated instances, frame times in this page -------------------------------
+
+const benchScenes = new Map();
+
+async function benchScene(url, decode, instances) {
+  const key = `${url}|${decode}|${instances}`;
+  if (benchScenes.has(key)) return benchScenes.get(key);
+  const { clone } = await import('three/addons/utils/SkeletonUtils.js');
+  const gltf = await load(url, decode);
+  const scene = new THREE.Scene();
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 2));
+  const box = new THREE.Box3().setFromObject(gltf.scene), size = box.getSize(new THREE.Vector3());
+  const columns = Math.ceil(Math.sqrt(instances)), mixers = [];
+  for (let i = 0; i < instances; ++i) {
+    const copy = clone(gltf.scene);
+    copy.position.set((i % columns - columns / 2) * size.x * 1.2, 0, -Math.floor(i / columns) * size.z * 1.5);
+    copy.traverse((o) => { o.frustumCulled = false; });
+    scene.add(copy);
+    if (gltf.animations.length) {
+      const mixer = new THREE.AnimationMixer(copy);
+      mixer.clipAction(gltf.animations[0]).play();
+      mixers.push(mixer);
+    } else {
+      const bones = [];
+      copy.traverse((o) => { if (o.isBone) bones.push(o); });
+      mixers.push({ setTime: (t) => bones.forEach((b, j) => { b.rotation.z = 0.2 * Math.sin(t * 2 + j + i); }) });
+    }
+  }
+  const extent = columns * Math.max(size.x * 1.2, size.z * 1.5);
+  const camera = new THREE.PerspectiveCamera(45, 1, extent / 100, extent * 10);
+  camera.position.set(0, extent * 0.6, extent * 0.9);
+  camera.lookAt(0, 0, -extent / 3);
+  const result = { scene, camera, mixers };
+  benchScenes.set(key, result);
+  return result;
+}
+
+/** Median and mean frame time (ms) of frames renders (each synchronised by a 1-pixel read). */
+async function benchmark(url, decode, instances, frames) {
+  const { scene, camera, mixers } = await benchScene(url, decode, instances);
+  const gl = renderer.getContext(), pixel = new Uint8Array(4), times = [];
+  renderer.shadowMap.enabled = false;
+  for (let f = -3; f < frames; ++f) {
+    const start = performance.now();
+    mixers.forEach((m, i) => m.setTime(f / 30 + i * 0.01));
+    renderer.render(scene, camera);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    if (f >= 0) times.push(performance.now() - start);
+  }
+  renderer.shadowMap.enabled = true;
+  times.sort((a, b) => a - b);
+  const info = { calls: renderer.info.render.calls, triangles: renderer.info.render.triangles };
+  return { median: times[times.length >> 1], mean: times.reduce((a, b) => a + b, 0) / times.length, info };
+}
+
+window.skinpackTest = { render, loadError, gpuReadback, gpuConformance, benchmark };
 window.skinpackTestReady = true;
