@@ -13,7 +13,7 @@ import {
   RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
 } from 'three';
 import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from './decode.js';
-import { codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
+import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
 const TABLE_TYPES = ['SCALAR', 'VEC2', 'VEC3', 'VEC4'];
@@ -198,8 +198,8 @@ export function skinpackMaterial(mesh, material) {
   const data = skinpackData(mesh);
   if (!data || !data.uniforms) throw new Error('skinpackMaterial: the mesh does not use GPU decode');
   const patched = material.clone();
-  patched.onBeforeCompile = (shader) => patchSkinningShader(shader, data.uniforms);
-  patched.customProgramCacheKey = () => 'skinpack-gpu';
+  patched.onBeforeCompile = (shader) => patchSkinningShader(shader, data.uniforms, data.codec);
+  patched.customProgramCacheKey = () => codecProgramKey(data.codec);
   return patched;
 }
 

@@ -55,6 +55,13 @@ uniform highp uvec4 skinpackBits;    // fixed/cube/pot: bits of each stored weig
 uniform highp uvec4 skinpackAxes;    // any: q2, q3, q4
 uniform highp vec4 skinpackFactors;  // any: i (q_i - 1), the divisor of axis i
 
+// The skinning shaders fix method and K at compile time (one program per codec kind, every
+// other decoder compiled out); the read-back test leaves them to the uniforms.
+#ifndef SKINPACK_METHOD
+#define SKINPACK_METHOD skinpackConfig.x
+#define SKINPACK_K skinpackConfig.y
+#endif
+
 highp uint skinpackRowBase(highp uint n, highp uint j) {
   return (j * (4u * n + 2u - 3u * j) + 1u) / 4u;
 }
@@ -104,7 +111,7 @@ highp uint skinpackLowBits(highp uint value, highp uint bits) {
 }
 // Exact integers q1..q4 (any: x2..x4 in slots 2..4) and the float weights of one code.
 highp vec4 skinpackDecodeWeights(highp uint code, out highp uvec4 q) {
-  highp uint method = skinpackConfig.x, k = skinpackConfig.y;
+  highp uint method = SKINPACK_METHOD, k = SKINPACK_K;
   q = uvec4(0u);
   if (k == 1u) { q.x = 1u; return vec4(1.0, 0.0, 0.0, 0.0); }
   if (method == 3u) { // any
@@ -168,12 +175,18 @@ function renamed(chunk) {
   return chunk.replace(/\bskinIndex\b/g, 'skinpackIndex').replace(/\bskinWeight\b/g, 'skinpackWeight');
 }
 
+/** The program variant of a codec: method and K are compile-time constants of the shader. */
+export function codecProgramKey(codec) {
+  return `skinpack-gpu-${codec.methodId}-${codec.influences}`;
+}
+
 /** Patches a three.js shader (onBeforeCompile's argument) to skin from the packed word. */
-export function patchSkinningShader(shader, uniforms) {
+export function patchSkinningShader(shader, uniforms, codec) {
   Object.assign(shader.uniforms, uniforms);
+  const constants = `#define SKINPACK_METHOD ${codec.methodId}u\n#define SKINPACK_K ${codec.influences}u\n`;
   shader.vertexShader = shader.vertexShader
     .replace('#include <skinning_pars_vertex>',
-             `#include <skinning_pars_vertex>\n#ifdef USE_SKINNING\nin highp uint skinpackWord;\n${DECODE_GLSL}\n#endif`)
+             `#include <skinning_pars_vertex>\n#ifdef USE_SKINNING\nin highp uint skinpackWord;\n${constants}${DECODE_GLSL}\n#endif`)
     .replace('#include <skinbase_vertex>',
              `#ifdef USE_SKINNING\nhighp uvec4 skinpackJoints; highp vec4 skinpackWeight; highp uvec4 skinpackQ;\n` +
              `skinpackDecode(skinpackWord, skinpackJoints, skinpackWeight, skinpackQ);\n` +
