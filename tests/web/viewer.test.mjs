@@ -51,7 +51,7 @@ test('a fallback file: stats, decode toggle, original weights, error colours, an
   await settle();
   meshes = await text('#meshes');
   assert.match(meshes, /CPU decode/);
-  assert.match(meshes, /GPU bytes for the skin\s+[\d,]+ \(192\.0 bits\/v\)/); // 4 x u16 joints + 4 x f32 weights
+  assert.match(meshes, /GPU bytes for the skin\s+[\d,]+ \(160\.0 bits\/v\)/); // 4 x u8 joints + 4 x f32 weights
 
   await page.click('#weights-original');
   await settle();

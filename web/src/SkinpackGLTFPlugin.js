@@ -152,9 +152,10 @@ export class SkinpackGLTFPlugin {
       skinIndex: geometry.getAttribute('skinIndex'), skinWeight: geometry.getAttribute('skinWeight') } });
     if (refusal) {
       if (this.decode === 'gpu') console.warn(`SkinpackGLTFPlugin: ${where}: CPU decode: ${refusal}`);
-      geometry.setAttribute('skinIndex', new BufferAttribute(decoded.joints, 4));
+      const joints = codec.jointCount <= 256 ? Uint8Array.from(decoded.joints) : decoded.joints; // as glTF stores them
+      geometry.setAttribute('skinIndex', new BufferAttribute(joints, 4));
       geometry.setAttribute('skinWeight', new BufferAttribute(decoded.weights, 4));
-      info.gpuSkinBytes = decoded.joints.byteLength + decoded.weights.byteLength;
+      info.gpuSkinBytes = joints.byteLength + decoded.weights.byteLength;
       return;
     }
     attachGpuSkin(mesh, packed);

@@ -95,6 +95,24 @@ async function render(url, decode, times, copy = false) {
   return { images, modes, size: SIZE, info: { ...renderer.info.memory } };
 }
 
+/** Plain three.js: the load error, or what its skin attributes hold (distinct weight vectors, largest joint). */
+async function plainSkinWeights(url) {
+  try {
+    const gltf = await load(url, null);
+    const weights = new Set();
+    let maxJoint = 0;
+    gltf.scene.traverse((o) => {
+      if (!o.isSkinnedMesh) return;
+      const w = o.geometry.getAttribute('skinWeight'), j = o.geometry.getAttribute('skinIndex');
+      for (let v = 0; v < w.count; ++v) weights.add([w.getX(v), w.getY(v), w.getZ(v), w.getW(v)].join());
+      for (const joint of j.array) maxJoint = Math.max(maxJoint, joint);
+    });
+    return { weights: [...weights], maxJoint };
+  } catch (error) {
+    return { error: String(error && error.message ? error.message : error) };
+  }
+}
+
 async function loadError(url, decode) {
   try {
     await load(url, decode);
@@ -312,5 +330,5 @@ async function benchmark(url, decode, instances, frames) {
   return { median: times[times.length >> 1], mean: times.reduce((a, b) => a + b, 0) / times.length, info };
 }
 
-window.skinpackTest = { render, loadError, gpuReadback, gpuConformance, benchmark };
+window.skinpackTest = { render, loadError, plainSkinWeights, gpuReadback, gpuConformance, benchmark };
 window.skinpackTestReady = true;
