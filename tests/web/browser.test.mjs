@@ -217,6 +217,8 @@ const BROKEN = {
     copy.extensions[SKINPACK_EXTENSION].jointCount -= 1;
     json.meshes.push({ name: 'fox1', primitives: [copy] });
   }, /shares "vertices" accessor \d+ with mesh 0 "fox1" primitive 0 but declares different properties/, 'mesh 1 "fox1" primitive 0'],
+  wordsRange: [(json) => { json.accessors[extOf(json).vertices].byteOffset = 8; }, /"vertices" accessor \d+ ends at byte \d+, past its bufferView/],
+  sparse: [(json) => { json.accessors[extOf(json).tupleTable].normalized = true; }, /"tupleTable" accessor \d+ must be neither sparse nor normalized/],
   tableEntry: [(json, bin) => {
     const accessor = json.accessors[extOf(json).tupleTable];
     bin[(json.bufferViews[accessor.bufferView].byteOffset || 0) + 1] = extOf(json).jointCount;

@@ -104,8 +104,7 @@ export class SkinpackGLTFPlugin {
     const tableComponent = codec.jointCount <= 256 ? COMPONENT_UNSIGNED_BYTE : COMPONENT_UNSIGNED_SHORT;
     if (tableDef.componentType !== tableComponent || tableDef.type !== TABLE_TYPES[codec.influences - 1])
       throw new Error(`"tupleTable" accessor ${ext.tupleTable} must be ${tableComponent === COMPONENT_UNSIGNED_BYTE ? 'UNSIGNED_BYTE' : 'UNSIGNED_SHORT'} ${TABLE_TYPES[codec.influences - 1]}`);
-    if (wordsDef.bufferView === undefined || tableDef.bufferView === undefined)
-      throw new Error('the extension\'s accessors have no bufferView');
+    for (const [field, accessor] of [['vertices', wordsDef], ['tupleTable', tableDef]]) this._checkAccessor(field, ext[field], accessor);
     const position = json.accessors[primitive.attributes.POSITION];
     if (!position || position.count !== wordsDef.count)
       throw new Error(`"vertices" has ${wordsDef.count} entries for ${position ? position.count : 0} vertices`);
@@ -114,6 +113,24 @@ export class SkinpackGLTFPlugin {
     const words = wordsAttribute.array, lut = tableAttribute.array;
     const decoded = decodeSkin(codec, words, lut);
     return { codec, words, lut, decoded, compact: this._isCompact(primitive) };
+  }
+
+  // Tightly packed, not normalized, not sparse, inside its bufferView (spec 1.0, Accessors).
+  _checkAccessor(field, index, accessor) {
+    const json = this.parser.json;
+    const name = `"${field}" accessor ${index}`;
+    if (accessor.bufferView === undefined) throw new Error(`${name} has no bufferView`);
+    if (accessor.sparse || accessor.normalized) throw new Error(`${name} must be neither sparse nor normalized`);
+    const view = json.bufferViews[accessor.bufferView];
+    if (!view) throw new Error(`${name}: bufferView ${accessor.bufferView} does not exist`);
+    const componentBytes = { [COMPONENT_UNSIGNED_BYTE]: 1, [COMPONENT_UNSIGNED_SHORT]: 2, [COMPONENT_UNSIGNED_INT]: 4 }[accessor.componentType];
+    const size = componentBytes * (TABLE_TYPES.indexOf(accessor.type) + 1); // types were checked above
+    if (view.byteStride && view.byteStride !== size) throw new Error(`${name} must be tightly packed (byteStride ${view.byteStride})`);
+    const end = (accessor.byteOffset || 0) + accessor.count * size;
+    if (end > view.byteLength) throw new Error(`${name} ends at byte ${end}, past its bufferView's ${view.byteLength}`);
+    const buffer = json.buffers[view.buffer];
+    if (!buffer || (view.byteOffset || 0) + view.byteLength > buffer.byteLength)
+      throw new Error(`${name}: bufferView ${accessor.bufferView} lies outside its buffer`);
   }
 
   _checkJointCount(meshIndex, codec) {
