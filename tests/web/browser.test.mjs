@@ -9,7 +9,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { copyFileSync, writeFileSync } from 'node:fs';
 import { basename, join } from 'node:path';
-import { allCases, WORK } from './cases.mjs';
+import { allCases, fallbackBufferLayout, WORK } from './cases.mjs';
 import { openTestPage, compareImages } from './browser.mjs';
 import { readGltf, writeGlb } from './gltf_file.mjs';
 import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
@@ -132,30 +132,6 @@ test('every conformance vector of the 32-bit GPU profile decodes exactly in the 
 });
 
 // ---- compact files without the plugin, broken files with it --------------------------------
-
-/** Issue 10's compact layout: JOINTS_0/WEIGHTS_0 point at bufferViews of a buffer without data
- *  that is marked as our fallback (as EXT_meshopt_compression does). */
-function fallbackBufferLayout(compact, out) {
-  const { json, buffers } = readGltf(compact);
-  const fallback = json.buffers.length;
-  let length = 0;
-  const views = new Map();
-  for (const mesh of json.meshes) for (const primitive of mesh.primitives) {
-    if (!primitive.extensions || !primitive.extensions[SKINPACK_EXTENSION]) continue;
-    for (const name of ['JOINTS_0', 'WEIGHTS_0']) {
-      const index = primitive.attributes[name];
-      if (index === undefined || views.has(index)) continue;
-      const accessor = json.accessors[index];
-      const bytes = accessor.count * 4 * (accessor.componentType === 5126 ? 4 : accessor.componentType === 5123 ? 2 : 1);
-      views.set(index, json.bufferViews.length);
-      json.bufferViews.push({ buffer: fallback, byteOffset: length, byteLength: bytes });
-      accessor.bufferView = views.get(index);
-      length += bytes;
-    }
-  }
-  json.buffers.push({ byteLength: length, extensions: { [SKINPACK_EXTENSION]: { fallback: true } } });
-  writeGlb(out, json, buffers[0]);
-}
 
 test('compact files: plain three.js rejects the fallback-buffer layout; the plugin renders it', async () => {
   const fox = cases.find((c) => c.name === 'Fox_compact');

@@ -4,6 +4,8 @@
 import { execFileSync } from 'node:child_process';
 import { existsSync, mkdirSync, statSync } from 'node:fs';
 import { basename, join } from 'node:path';
+import { readGltf, writeGlb } from './gltf_file.mjs';
+import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
 
 export const CLI = process.env.SKINPACK_CLI;
 export const WORK = process.env.SKINPACK_WEB_WORK || '/tmp/skinpack_web';
@@ -60,4 +62,28 @@ export function allCases() {
   const fox = ASSETS.find((a) => basename(a) === 'Fox.glb');
   if (fox) for (const [tag, args] of Object.entries(FOX_VARIANTS)) cases.push(makeCase(fox, tag, args));
   return cases;
+}
+
+/** Issue 10's compact layout: JOINTS_0/WEIGHTS_0 point at bufferViews of a buffer without data
+ *  that is marked as our fallback (as EXT_meshopt_compression does). */
+export function fallbackBufferLayout(compact, out) {
+  const { json, buffers } = readGltf(compact);
+  const fallback = json.buffers.length;
+  let length = 0;
+  const views = new Map();
+  for (const mesh of json.meshes) for (const primitive of mesh.primitives) {
+    if (!primitive.extensions || !primitive.extensions[SKINPACK_EXTENSION]) continue;
+    for (const name of ['JOINTS_0', 'WEIGHTS_0']) {
+      const index = primitive.attributes[name];
+      if (index === undefined || views.has(index)) continue;
+      const accessor = json.accessors[index];
+      const bytes = accessor.count * 4 * (accessor.componentType === 5126 ? 4 : accessor.componentType === 5123 ? 2 : 1);
+      views.set(index, json.bufferViews.length);
+      json.bufferViews.push({ buffer: fallback, byteOffset: length, byteLength: bytes });
+      accessor.bufferView = views.get(index);
+      length += bytes;
+    }
+  }
+  json.buffers.push({ byteLength: length, extensions: { [SKINPACK_EXTENSION]: { fallback: true } } });
+  writeGlb(out, json, buffers[0]);
 }

@@ -8,7 +8,7 @@ import { execFileSync } from 'node:child_process';
 import { existsSync } from 'node:fs';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { allCases, CLI, WORK } from './cases.mjs';
+import { allCases, CLI, fallbackBufferLayout, WORK } from './cases.mjs';
 import { readGltf, readAccessor } from './gltf_file.mjs';
 import { core, functions, MeshoptEncoder } from './web_modules.mjs';
 import { SkinpackPackedSkin, WORDS_ATTRIBUTE } from '../../web/gltf-transform/SkinpackPackedSkin.js';
@@ -106,6 +106,18 @@ for (const c of cases) {
     assertSameSkins(c.decoded, out, `${c.name} optimize`);
   });
 }
+
+test('compact files in the fallback-buffer layout: read, welded, written compact with the same skins', async () => {
+  const fox = cases.find((c) => c.name === 'Fox_compact');
+  const input = join(WORK, 'Fox_compact_fallback_buffer_gt.glb');
+  fallbackBufferLayout(fox.packed, input);
+  const document = await io.read(input);
+  await document.transform(functions.weld());
+  const out = join(WORK, 'Fox_compact_fallback_buffer_gt_weld.glb');
+  await io.write(out, document);
+  assert.deepEqual(packedState(out), { compact: true, required: true });
+  assert.ok(assertSameSkins(fox.decoded, out, 'fallback-buffer weld') < 1728, 'weld merged nothing');
+});
 
 test('a write whose words no longer match the vertices is refused, naming mesh and primitive', async () => {
   const fox = cases.find((c) => c.name === 'Fox_fallback');

@@ -11,9 +11,11 @@
 // result that no longer decodes (or whose word count left the vertex count) makes the write
 // throw, naming the mesh and primitive, instead of writing a silently wrong skin.
 // Meshlets index vertices and triangles; operations invalidate them, so they are dropped on read.
+// Compact files are written with data-less JOINTS_0/WEIGHTS_0 accessors (no bufferView), also
+// when read in the fallback-buffer layout (a GLB written by glTF-Transform holds one buffer).
 
 import { Extension, ExtensionProperty, PropertyType } from '@gltf-transform/core';
-import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from '../src/decode.js';
+import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from '../src/decode.js';
 
 export const WORDS_ATTRIBUTE = '_SKINPACK_WORDS';
 const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'weightBits', 'tupleBits', 'maxError'];
@@ -66,8 +68,7 @@ export class SkinpackPackedSkin extends Extension {
       for (const key of PARAMETERS) if (def[key] !== undefined) parameters[key] = def[key];
       packed.setParameters(parameters);
       if (def.meshlets) this.document.getLogger().warn(`${SKINPACK_EXTENSION}: ${where}: meshlets dropped (operations invalidate them; rebuild with skinpack compress --meshlets)`);
-      const joints = primitiveDef.attributes.JOINTS_0;
-      const compact = joints === undefined || json.accessors[joints].bufferView === undefined;
+      const compact = compactLayout(json, primitiveDef) !== null;
       packed.setCompact(compact);
       if (compact) for (const name of ['JOINTS_0', 'WEIGHTS_0']) {
         const placeholder = primitive.getAttribute(name);
@@ -77,6 +78,11 @@ export class SkinpackPackedSkin extends Extension {
       primitive.setAttribute(WORDS_ATTRIBUTE, words);
       primitive.setExtension(SKINPACK_EXTENSION, packed);
     }));
+    // A data-less fallback buffer is unused now (GLB holds one buffer): dropped.
+    (json.buffers || []).forEach((bufferDef, b) => {
+      const buffer = context.buffers[b];
+      if (isFallbackBuffer(bufferDef) && buffer && buffer.listParents().every((p) => p.propertyType === PropertyType.ROOT)) buffer.dispose();
+    });
     return this;
   }
 

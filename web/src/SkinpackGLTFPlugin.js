@@ -12,7 +12,7 @@ import {
   BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,
   RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
 } from 'three';
-import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from './decode.js';
+import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from './decode.js';
 import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
@@ -67,9 +67,7 @@ export class SkinpackGLTFPlugin {
   loadBufferView(index) {
     const json = this.parser.json;
     const view = json.bufferViews[index];
-    const buffer = json.buffers[view.buffer];
-    const mark = buffer && buffer.extensions && buffer.extensions[SKINPACK_EXTENSION];
-    if (!mark || mark.fallback !== true) return null;
+    if (!isFallbackBuffer(json.buffers[view.buffer])) return null;
     return Promise.resolve(new ArrayBuffer(view.byteLength || 0));
   }
 
@@ -112,7 +110,7 @@ export class SkinpackGLTFPlugin {
       this.parser.getDependency('accessor', ext.vertices), this.parser.getDependency('accessor', ext.tupleTable)]);
     const words = wordsAttribute.array, lut = tableAttribute.array;
     const decoded = decodeSkin(codec, words, lut);
-    return { codec, words, lut, decoded, compact: this._isCompact(primitive) };
+    return { codec, words, lut, decoded, compact: compactLayout(json, primitive) !== null };
   }
 
   // Tightly packed, not normalized, not sparse, inside its bufferView (spec 1.0, Accessors).
@@ -140,15 +138,6 @@ export class SkinpackGLTFPlugin {
       const joints = json.skins[node.skin].joints.length;
       if (codec.jointCount > joints) throw new Error(`"jointCount" = ${codec.jointCount} exceeds the ${joints} joints of skin ${node.skin}`);
     }
-  }
-
-  _isCompact(primitive) {
-    const json = this.parser.json;
-    if (primitive.attributes.JOINTS_0 === undefined) return true;
-    const accessor = json.accessors[primitive.attributes.JOINTS_0];
-    if (accessor.bufferView === undefined) return true;
-    const buffer = json.buffers[json.bufferViews[accessor.bufferView].buffer];
-    return !!(buffer.extensions && buffer.extensions[SKINPACK_EXTENSION] && buffer.extensions[SKINPACK_EXTENSION].fallback);
   }
 
   _attach(mesh, packed, where) {

@@ -67,6 +67,29 @@ function bitWidth(value) { // bits of a BigInt value (0 for 0)
   return bits;
 }
 
+/**
+ * Whether a primitive is in compact mode (its JOINTS_0/WEIGHTS_0 carry no data), from the glTF
+ * JSON: the attributes are absent, their accessor has no bufferView, or its bufferView lies in
+ * a buffer marked as our data-less fallback (EXT_meshopt_compression style:
+ * `buffers[i].extensions.SKINPACK_packed_skin.fallback = true`). Returns null (fallback mode),
+ * 'absent', 'no-bufferView' or 'fallback-buffer'.
+ */
+export function compactLayout(json, primitiveDef) {
+  const index = primitiveDef.attributes.JOINTS_0;
+  if (index === undefined) return 'absent';
+  const accessor = json.accessors[index];
+  if (accessor.bufferView === undefined) return 'no-bufferView';
+  const view = json.bufferViews[accessor.bufferView];
+  const buffer = view && json.buffers[view.buffer];
+  return isFallbackBuffer(buffer) ? 'fallback-buffer' : null;
+}
+
+/** A buffer without data that only compact primitives' JOINTS_0/WEIGHTS_0 point into. */
+export function isFallbackBuffer(buffer) {
+  const mark = buffer && buffer.extensions && buffer.extensions[SKINPACK_EXTENSION];
+  return !!(mark && mark.fallback === true);
+}
+
 // ---- OSS closed forms (BigInt, exact) -------------------------------------------------------
 
 export function ossRowBase(n, j) {
