@@ -36,10 +36,10 @@ export function codecUniformValues(codec, lutWidth) {
   return { config, params, bits, axes, factors };
 }
 
-/** The tuple table as RGBA16UI texels (one entry a texel, TUPLE_TEXTURE_WIDTH a row). */
-export function tupleTexels(lut, influences) {
+/** The tuple table as RGBA16UI texels (one entry a texel, rowWidth entries a row). */
+export function tupleTexels(lut, influences, rowWidth = TUPLE_TEXTURE_WIDTH) {
   const entries = lut.length / influences;
-  const width = Math.min(entries, TUPLE_TEXTURE_WIDTH), height = Math.ceil(entries / width);
+  const width = Math.min(entries, rowWidth), height = Math.ceil(entries / width);
   const texels = new Uint16Array(width * height * 4);
   for (let e = 0; e < entries; ++e)
     for (let s = 0; s < influences; ++s) texels[e * 4 + s] = lut[e * influences + s];

@@ -171,12 +171,12 @@ function readbackContext() {
 }
 
 /** Decodes words (one a vertex) with tuple table lut in the shader; returns q, joints, weight bits. */
-function gpuDecode(codec, words, lut) {
+function gpuDecode(codec, words, lut, rowWidth) {
   const { gl, program, table, words: buffer, framebuffer, targets } = readbackContext();
   const vertexCount = words.length;
   const width = Math.max(1, Math.ceil(Math.sqrt(vertexCount)));
   gl.useProgram(program);
-  const { texels, width: lutWidth, height: lutHeight } = tupleTexels(lut, codec.influences);
+  const { texels, width: lutWidth, height: lutHeight } = tupleTexels(lut, codec.influences, rowWidth);
   gl.activeTexture(gl.TEXTURE0);
   gl.bindTexture(gl.TEXTURE_2D, table);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
@@ -242,8 +242,9 @@ function gpuConformance(groups) {
   return { mismatches: mismatches.slice(0, 10), mismatchCount: mismatches.length, maxWeightError, exactWeights, total };
 }
 
-/** Loads url with the plugin (CPU decode) and compares the shader's decode with the CPU's. */
-async function gpuReadback(url) {
+/** Loads url with the plugin (CPU decode) and compares the shader's decode with the CPU's
+ *  (rowWidth: tuple texture row length, small to test the row addressing). */
+async function gpuReadback(url, rowWidth) {
   const gltf = await load(url, 'cpu');
   const results = [];
   const seen = new Set();
@@ -251,7 +252,7 @@ async function gpuReadback(url) {
     const data = o.isMesh && skinpackData(o);
     if (!data || seen.has(data)) return;
     seen.add(data);
-    const gpu = gpuDecode(data.codec, data.words, data.lut);
+    const gpu = gpuDecode(data.codec, data.words, data.lut, rowWidth);
     const cpuWeightBits = new Uint32Array(data.decoded.weights.buffer);
     let jointMismatches = 0, weightMismatches = 0, maxUlp = 0, first = null;
     for (let i = 0; i < gpu.joints.length; ++i) {
