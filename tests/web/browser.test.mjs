@@ -11,7 +11,7 @@ import { copyFileSync, writeFileSync } from 'node:fs';
 import { basename, join } from 'node:path';
 import { allCases, fallbackBufferLayout, WORK } from './cases.mjs';
 import { openTestPage, compareImages } from './browser.mjs';
-import { readGltf, writeGlb } from './gltf_file.mjs';
+import { readAccessor, readGltf, writeGlb } from './gltf_file.mjs';
 import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
 import { gpuProfileRefusal } from '../../web/src/gpu.js';
 import { readVectors } from './conformance.mjs';
@@ -83,6 +83,39 @@ test('a SkeletonUtils clone of a GPU-decoded scene renders the same (shadows, bo
   const decoded = await reference(fox.decoded, FOX_TIMES);
   assert.deepEqual(cloned.modes, ['gpu']);
   cloned.images.forEach((image, i) => assert.equal(compareImages(decoded.images[i], image, NOISE).differing, 0, `t = ${FOX_TIMES[i]}`));
+});
+
+// A morph target (a stretch along y) on Fox's skinned primitive, the same edit on the packed and
+// on the decompressed file: morphing and skinning together on both paths.
+function withMorphTarget(path, out) {
+  const { json, buffers } = readGltf(path);
+  const primitive = json.meshes[0].primitives[0];
+  const positions = readAccessor({ json, buffers }, primitive.attributes.POSITION);
+  const deltas = new Float32Array(positions.length);
+  for (let v = 0; v < positions.length; v += 3) deltas[v + 1] = 0.4 * positions[v + 1];
+  const bin = new Uint8Array(((buffers[0].length + 3) & ~3) + deltas.byteLength);
+  bin.set(buffers[0]);
+  bin.set(new Uint8Array(deltas.buffer), bin.length - deltas.byteLength);
+  json.bufferViews.push({ buffer: 0, byteOffset: bin.length - deltas.byteLength, byteLength: deltas.byteLength });
+  json.accessors.push({ bufferView: json.bufferViews.length - 1, componentType: 5126, count: deltas.length / 3, type: 'VEC3' });
+  primitive.targets = [{ POSITION: json.accessors.length - 1 }];
+  json.meshes[0].weights = [0];
+  json.buffers[0].byteLength = bin.length;
+  writeGlb(out, json, bin);
+  return out;
+}
+
+test('a skinned primitive with a morph target renders the same on both paths (morphing and skinning)', async () => {
+  const fox = cases.find((c) => c.name === 'Fox_fallback');
+  const packed = withMorphTarget(fox.packed, join(WORK, 'Fox_morph.glb'));
+  const decoded = withMorphTarget(fox.decoded, join(WORK, 'Fox_morph_decoded.glb'));
+  const reference = await render(decoded, null, FOX_TIMES), unmorphed = await render(fox.decoded, null, FOX_TIMES);
+  assert.ok(compareImages(reference.images[0], unmorphed.images[0], NOISE).differing > 200, 'the morph target changes nothing');
+  for (const decode of ['gpu', 'cpu']) {
+    const result = await render(packed, decode, FOX_TIMES);
+    assert.ok(result.skinnedMorphs > 0);
+    result.images.forEach((image, i) => assert.equal(compareImages(reference.images[i], image, NOISE).differing, 0, `${decode} t = ${FOX_TIMES[i]}`));
+  }
 });
 
 test('the GPU path covers the 32-bit profile and hands wider codecs to the CPU', () => {

@@ -20,8 +20,12 @@ function load(url, decode) {
   return loader.loadAsync(url);
 }
 
-// A pose every file gets on top of its animation, so files without animations still deform.
+// A pose every file gets on top of its animation, so files without animations still deform,
+// and morph target weights, so morphing and skinning are tested together.
 function pose(gltf, time) {
+  gltf.scene.traverse((o) => {
+    if (o.morphTargetInfluences) o.morphTargetInfluences.forEach((_, i, all) => { all[i] = 0.5 + 0.5 * Math.sin(time * 3 + i); });
+  });
   const bones = [];
   gltf.scene.traverse((o) => { if (o.isBone) bones.push(o); });
   bones.forEach((bone, i) => {
@@ -81,7 +85,11 @@ async function render(url, decode, times, copy = false) {
   const mixer = gltf.animations.length ? new THREE.AnimationMixer(gltf.scene) : null;
   if (mixer) mixer.clipAction(gltf.animations[0]).play();
   const images = [], modes = [];
-  gltf.scene.traverse((o) => { if (o.userData.skinpack) modes.push(o.userData.skinpack.decode); });
+  let skinnedMorphs = 0;
+  gltf.scene.traverse((o) => {
+    if (o.userData.skinpack) modes.push(o.userData.skinpack.decode);
+    if (o.isSkinnedMesh && o.morphTargetInfluences) skinnedMorphs++;
+  });
   const rest = new Map();
   gltf.scene.traverse((o) => { if (o.isBone) rest.set(o, o.quaternion.clone()); });
   for (const time of times) {
@@ -92,7 +100,7 @@ async function render(url, decode, times, copy = false) {
     images.push(toBase64(pixels()));
   }
   renderer.renderLists.dispose();
-  return { images, modes, size: SIZE, info: { ...renderer.info.memory } };
+  return { images, modes, skinnedMorphs, size: SIZE, info: { ...renderer.info.memory } };
 }
 
 /** Plain three.js: the load error, or what its skin attributes hold (distinct weight vectors, largest joint). */
