@@ -91,6 +91,14 @@ test('a broken file is shown as an error naming mesh and primitive', async () =>
   assert.match(await text('#status'), /mesh 0 "fox1" primitive 0: "tupleBits"/);
 });
 
+test('a file opened with the Open button decodes too', async () => {
+  await page.goto(`${url}/viewer/`);
+  await page.setInputFiles('#file', fox('compact').packed);
+  await page.waitForFunction(() => window.skinpackViewer.state.gltf && window.skinpackViewer.state.name === 'Fox_compact.glb', null, { timeout: 60000 });
+  assert.match(await text('#meshes'), /GPU decode/);
+  assert.match(await text('#title'), /Fox_compact\.glb/);
+});
+
 test('screenshot', async () => {
   await open(fox('fallback').packed, '&time=1.2');
   await page.waitForTimeout(1500);
