@@ -13,7 +13,8 @@
  * sp_result_string() turns it into a message. "K" is the number of influences kept per vertex
  * (1..4); per-vertex arrays of influences are dense, K (or the input stride) entries a vertex.
  *
- * The exact bit layout the library writes is specified in docs/format.md.
+ * The format is specified in docs/extension/README.md (1.0; conformance vectors in
+ * docs/extension/conformance/) and explained in docs/format.md.
  */
 #ifndef SKINPACK_H
 #define SKINPACK_H
@@ -400,6 +401,10 @@ typedef struct sp_packed_params {
     uint32_t has_max_error;
     double max_error;           /* "maxError" when has_max_error */
 } sp_packed_params;
+
+/* 1 if two primitives declare the same parameters (every field; axis_samples only up to
+ * axis_sample_count), else 0. Primitives that share a "vertices" accessor must (docs/extension). */
+SP_API int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b);
 
 /* The optional meshlet arrays (docs/extension: "meshlets"), each widened to the type here. */
 typedef struct sp_packed_meshlets {

@@ -25,9 +25,11 @@ static sp_result check_params(const sp_packed_params* p, sp_validation* report)
 {
     if (p->method >= SP_METHOD_COUNT) return fail(report, SP_ERR_UNSUPPORTED_METHOD, SP_FIELD_METHOD, 0, p->method, 0);
     if (p->influences < 1 || p->influences > SP_MAX_INFLUENCES)
-        return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, 0, p->influences, SP_MAX_INFLUENCES);
+        return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, 0, p->influences,
+                    p->influences < 1 ? 1 : SP_MAX_INFLUENCES);
     if (p->joint_count < 1 || p->joint_count > SP_MAX_JOINTS)
-        return fail(report, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, 0, p->joint_count, SP_MAX_JOINTS);
+        return fail(report, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, 0, p->joint_count,
+                    p->joint_count < 1 ? 1 : SP_MAX_JOINTS);
     if (p->weight_bits > SP_MAX_WEIGHT_BITS)
         return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, 0, p->weight_bits, SP_MAX_WEIGHT_BITS);
     if (p->tuple_bits > 32)
@@ -43,7 +45,8 @@ static sp_result check_params(const sp_packed_params* p, sp_validation* report)
     } else {
         uint64_t lo = p->method == SP_METHOD_OSS || p->method == SP_METHOD_POT ? 2 : 1;
         uint64_t hi = p->method == SP_METHOD_OSS ? ((uint64_t)1 << 63) : 64;
-        if (p->n < lo || p->n > hi) return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, 0, p->n, hi);
+        if (p->n < lo || p->n > hi)
+            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, 0, p->n, p->n < lo ? lo : hi);
     }
     for (uint32_t a = 0; a < want_axes; ++a)
         if (p->axis_samples[a] < 2)
@@ -140,7 +143,8 @@ static sp_result check_meshlet_limits(const sp_packed_meshlets* ml, uint32_t lim
     const uint32_t declared[3] = {ml->max_vertices, ml->max_triangles, ml->max_joints};
     for (uint32_t i = 0; i < 3; ++i) {
         if (declared[i] && (declared[i] < lowest[i] || declared[i] > highest[i]))
-            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, i, declared[i], highest[i]);
+            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, i, declared[i],
+                        declared[i] < lowest[i] ? lowest[i] : highest[i]);
         limits[i] = declared[i] ? declared[i] : highest[i];
     }
     limits[3] = 255; /* local tuple indices are u8 */
@@ -239,4 +243,16 @@ sp_result sp_validate_packed(const sp_packed_primitive* primitive, uint16_t* out
         report->codec = codec;
     }
     return r;
+}
+
+int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b)
+{
+    if (!a || !b) return 0;
+    int same = a->method == b->method && a->influences == b->influences && a->joint_count == b->joint_count &&
+               a->weight_bits == b->weight_bits && a->tuple_bits == b->tuple_bits && a->n == b->n &&
+               a->axis_sample_count == b->axis_sample_count && a->has_max_error == b->has_max_error &&
+               (!a->has_max_error || a->max_error == b->max_error);
+    for (uint32_t i = 0; same && i < a->axis_sample_count && i < SP_MAX_INFLUENCES - 1; ++i)
+        same = a->axis_samples[i] == b->axis_samples[i];
+    return same;
 }

@@ -164,18 +164,18 @@ static void valid_primitives(void)
 static void bad_parameters(const packed* base)
 {
     EXPECT(bad.params.method = SP_METHOD_COUNT, SP_ERR_UNSUPPORTED_METHOD, SP_FIELD_METHOD, "method: unknown");
-    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 out of range");
+    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 above the maximum 4");
     EXPECT(bad.params.influences = (uint64_t)1 << 32 | 4, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences");
-    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 out of range");
+    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 below the minimum 1");
     EXPECT(bad.params.joint_count = 70000, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount");
-    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65");
+    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65 above the maximum 64");
     EXPECT(bad.params.weight_bits -= 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits");
     EXPECT(bad.params.tuple_bits += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_TUPLE_BITS, "tupleBits");
     EXPECT(bad.params.tuple_bits = 33, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_TUPLE_BITS, "tupleBits: 33");
-    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 out of range");
+    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 below the minimum 2");
     EXPECT(bad.params.n = ((uint64_t)1 << 63) + 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n:");
     EXPECT(bad.params.n += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits"); /* n of more bits */
-    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000"); /* K = 4: > 64 bits */
+    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000 needs weight codes of more than 64 bits"); /* K = 4: > 64 bits */
     EXPECT(bad.params.axis_sample_count = 3, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_AXIS_SAMPLES, "axisSamples");
     EXPECT((bad.params.has_max_error = 1, bad.params.max_error = NAN), SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MAX_ERROR,
            "maxError: not a number");
@@ -187,6 +187,25 @@ static void bad_parameters(const packed* base)
            "vertices: 1024 packed vertices, the primitive has 1025");
     EXPECT(bad.lut_size = 0, SP_ERR_INDEX_OUT_OF_RANGE, SP_FIELD_TUPLE_TABLE, "tupleTable");
     EXPECT(bad.params.joint_count = 2, SP_ERR_JOINT_OUT_OF_RANGE, SP_FIELD_TUPLE_TABLE, "not below jointCount 2 at tuple");
+}
+
+/* Primitives sharing accessors must declare the same; unused axis entries do not count. */
+static void shared_parameters(const packed* base)
+{
+    sp_packed_params a = base->prim.params, b = a;
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b.axis_samples[2] = 77; /* not declared: OSS has no axisSamples */
+    CHECK(sp_packed_params_equal(&a, &b) == 1);
+    b = a, b.joint_count += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.n += 1;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.max_error *= 2;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.has_max_error = 0;
+    CHECK(sp_packed_params_equal(&a, &b) == 0);
+    b = a, b.method = SP_METHOD_ANY, b.axis_sample_count = 3;
+    CHECK(sp_packed_params_equal(&a, &b) == 0 && sp_packed_params_equal(&a, NULL) == 0);
 }
 
 /* Corrupt words and tables, each named by vertex. */
@@ -305,7 +324,7 @@ static void meshlets(packed* base)
     EXPECT(bad.meshlets = &b.view, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_MESHLET_TUPLES, "where the vertex decodes to");
     b = a;
     b.view.max_joints = 300;
-    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300");
+    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300 above the maximum 255");
     base->prim.meshlets = NULL;
 }
 
@@ -324,6 +343,7 @@ int main(void)
     o.weight_bits = 20; /* spare high bits for the corruptions */
     CHECK(compress(&o, &base) == SP_OK);
     bad_parameters(&base);
+    shared_parameters(&base);
     bad_data(&base);
     meshlets(&base);
     return check_report("test_validate");
