@@ -36,6 +36,12 @@ install_packages() {
        [ tools/package-lock.json -nt tools/node_modules/.package-lock.json ]; }; then
     (cd tools && npm ci --no-audit --no-fund --loglevel=error)
   fi
+  # The web runtime's packages (three, glTF-Transform, playwright-core driving Debian's chromium),
+  # pinned by web/package-lock.json, the same way.
+  if [ -f web/package.json ] && { [ ! -f web/node_modules/.package-lock.json ] ||
+       [ web/package-lock.json -nt web/node_modules/.package-lock.json ]; }; then
+    (cd web && npm ci --no-audit --no-fund --loglevel=error)
+  fi
 }
 
 build() {

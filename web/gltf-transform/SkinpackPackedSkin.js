@@ -1,0 +1,154 @@
+// SkinpackPackedSkin.js - SKINPACK_packed_skin for glTF-Transform (an Extension subclass).
+//
+//   const io = new NodeIO().registerExtensions([SkinpackPackedSkin]);
+//
+// In memory the packed words are a custom vertex attribute `_SKINPACK_WORDS` of the primitive,
+// so every operation that reorders, welds or splits vertices (weld, reorder, dedup, join, …)
+// carries them along with POSITION; the tuple table and the codec parameters live in a
+// PackedSkin property on the primitive. On write the attribute becomes the extension's
+// `vertices` accessor again (own bufferView, no target), compact primitives get their
+// JOINTS_0/WEIGHTS_0 placeholders without data back, and every primitive is decoded once: a
+// result that no longer decodes (or whose word count left the vertex count) makes the write
+// throw, naming the mesh and primitive, instead of writing a silently wrong skin.
+// Meshlets index vertices and triangles; operations invalidate them, so they are dropped on read.
+// Compact files are written with data-less JOINTS_0/WEIGHTS_0 accessors (no bufferView), also
+// when read in the fallback-buffer layout (a GLB written by glTF-Transform holds one buffer).
+
+import { Extension, ExtensionProperty, PropertyType } from '@gltf-transform/core';
+import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from '../src/decode.js';
+
+export const WORDS_ATTRIBUTE = '_SKINPACK_WORDS';
+const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'weightBits', 'tupleBits', 'maxError'];
+const UNSIGNED_BYTE = 5121, UNSIGNED_SHORT = 5123, FLOAT = 5126;
+
+/** The extension on one primitive: the tuple table accessor and the codec parameters. */
+export class PackedSkin extends ExtensionProperty {
+  static EXTENSION_NAME = SKINPACK_EXTENSION;
+
+  init() {
+    this.extensionName = SKINPACK_EXTENSION;
+    this.propertyType = 'PackedSkin';
+    this.parentTypes = [PropertyType.PRIMITIVE];
+  }
+
+  getDefaults() {
+    return Object.assign(super.getDefaults(), { tupleTable: null, parameters: {}, compact: false });
+  }
+
+  getTupleTable() { return this.getRef('tupleTable'); }
+  setTupleTable(accessor) { return this.setRef('tupleTable', accessor, { usage: 'SKINPACK_TUPLE_TABLE' }); }
+  /** influences, jointCount, method, n, axisSamples, weightBits, tupleBits, maxError. */
+  getParameters() { return { ...this.get('parameters') }; }
+  setParameters(parameters) { return this.set('parameters', { ...parameters }); }
+  /** Compact: JOINTS_0/WEIGHTS_0 are written as accessors without data. */
+  getCompact() { return this.get('compact'); }
+  setCompact(compact) { return this.set('compact', compact); }
+}
+
+export class SkinpackPackedSkin extends Extension {
+  static EXTENSION_NAME = SKINPACK_EXTENSION;
+  extensionName = SKINPACK_EXTENSION;
+  prewriteTypes = [PropertyType.ACCESSOR];
+
+  createPackedSkin() {
+    return new PackedSkin(this.document.getGraph());
+  }
+
+  read(context) {
+    const json = context.jsonDoc.json;
+    (json.meshes || []).forEach((meshDef, m) => meshDef.primitives.forEach((primitiveDef, p) => {
+      const def = primitiveDef.extensions && primitiveDef.extensions[SKINPACK_EXTENSION];
+      if (!def) return;
+      const where = `mesh ${m} primitive ${p}`;
+      const primitive = context.meshes[m].listPrimitives()[p];
+      const words = context.accessors[def.vertices], table = context.accessors[def.tupleTable];
+      if (!words || !table) throw new Error(`${SKINPACK_EXTENSION}: ${where}: "vertices" or "tupleTable" is not an accessor`);
+      const packed = this.createPackedSkin().setTupleTable(table);
+      const parameters = {};
+      for (const key of PARAMETERS) if (def[key] !== undefined) parameters[key] = def[key];
+      packed.setParameters(parameters);
+      if (def.meshlets) this.document.getLogger().warn(`${SKINPACK_EXTENSION}: ${where}: meshlets dropped (operations invalidate them; rebuild with skinpack compress --meshlets)`);
+      const compact = compactLayout(json, primitiveDef) !== null;
+      packed.setCompact(compact);
+      if (compact) for (const name of ['JOINTS_0', 'WEIGHTS_0']) {
+        const placeholder = primitive.getAttribute(name);
+        primitive.setAttribute(name, null);
+        if (placeholder && placeholder.listParents().length <= 1) placeholder.dispose();
+      }
+      primitive.setAttribute(WORDS_ATTRIBUTE, words);
+      primitive.setExtension(SKINPACK_EXTENSION, packed);
+    }));
+    // A data-less fallback buffer is unused now (GLB holds one buffer): dropped.
+    (json.buffers || []).forEach((bufferDef, b) => {
+      const buffer = context.buffers[b];
+      if (isFallbackBuffer(bufferDef) && buffer && buffer.listParents().every((p) => p.propertyType === PropertyType.ROOT)) buffer.dispose();
+    });
+    return this;
+  }
+
+  // Each packed array on its own bufferView without target (docs/extension/README.md).
+  prewrite(context) {
+    const usages = new Map();
+    for (const packed of this.properties) {
+      for (const primitive of packed.listParents().filter((p) => p.propertyType === PropertyType.PRIMITIVE)) {
+        const words = primitive.getAttribute(WORDS_ATTRIBUTE);
+        for (const accessor of [words, packed.getTupleTable()]) {
+          if (!accessor || usages.has(accessor)) continue;
+          usages.set(accessor, `SKINPACK_packed_skin:${usages.size}`);
+          context.addAccessorToUsageGroup(accessor, usages.get(accessor));
+        }
+      }
+    }
+    return this;
+  }
+
+  write(context) {
+    const json = context.jsonDoc.json;
+    let compact = false;
+    this.document.getRoot().listMeshes().forEach((mesh) => {
+      const meshIndex = context.meshIndexMap.get(mesh);
+      mesh.listPrimitives().forEach((primitive, p) => {
+        const packed = primitive.getExtension(SKINPACK_EXTENSION);
+        if (!packed) return;
+        const where = `${SKINPACK_EXTENSION}: mesh ${meshIndex}${mesh.getName() ? ` "${mesh.getName()}"` : ''} primitive ${p}`;
+        const primitiveDef = json.meshes[meshIndex].primitives[p];
+        const words = primitive.getAttribute(WORDS_ATTRIBUTE), table = packed.getTupleTable();
+        if (!words || !table) throw new Error(`${where}: the packed words or the tuple table are gone`);
+        const def = { vertices: context.accessorIndexMap.get(words), tupleTable: context.accessorIndexMap.get(table), ...packed.getParameters() };
+        checkDecodes(def, primitive, words, table, where);
+        delete primitiveDef.attributes[WORDS_ATTRIBUTE];
+        primitiveDef.extensions = primitiveDef.extensions || {};
+        primitiveDef.extensions[SKINPACK_EXTENSION] = def;
+        if (packed.getCompact()) {
+          compact = true;
+          addPlaceholders(json, primitiveDef, words.getCount(), def.jointCount);
+        }
+      });
+    });
+    if (compact && !(json.extensionsRequired || []).includes(SKINPACK_EXTENSION))
+      (json.extensionsRequired = json.extensionsRequired || []).push(SKINPACK_EXTENSION);
+    return this;
+  }
+}
+
+// The write refuses what would decode wrongly: word count off the vertex count, bad data.
+function checkDecodes(def, primitive, words, table, where) {
+  const position = primitive.getAttribute('POSITION');
+  if (position && position.getCount() !== words.getCount())
+    throw new Error(`${where}: ${words.getCount()} packed words for ${position.getCount()} vertices`);
+  try {
+    const codec = codecFromExtension(def);
+    if (words.getElementSize() !== codec.wordsPerVertex || !(words.getArray() instanceof Uint32Array))
+      throw new Error(`the packed words are no longer ${codec.wordsPerVertex} UNSIGNED_INT a vertex`);
+    decodeSkin(codec, words.getArray(), table.getArray());
+  } catch (error) {
+    throw new Error(`${where}: ${error.message}`);
+  }
+}
+
+// Compact mode: JOINTS_0/WEIGHTS_0 accessors without bufferView (KHR_draco_mesh_compression style).
+function addPlaceholders(json, primitiveDef, count, jointCount) {
+  json.accessors = json.accessors || [];
+  primitiveDef.attributes.JOINTS_0 = json.accessors.push({ componentType: jointCount <= 256 ? UNSIGNED_BYTE : UNSIGNED_SHORT, count, type: 'VEC4' }) - 1;
+  primitiveDef.attributes.WEIGHTS_0 = json.accessors.push({ componentType: FLOAT, count, type: 'VEC4' }) - 1;
+}
