@@ -14,8 +14,8 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->max_triangles = 124;
     options->max_joints = 32;
     options->min_group_triangles = 16;
-    options->joint_cost = 1.0f;
-    options->tuple_cost = 0.25f;
+    options->joint_cost = 0.25f;
+    options->tuple_cost = 0.0f;
 }
 
 static size_t align8(size_t bytes)
@@ -109,44 +109,6 @@ static void setup_scratch(sp_meshlet_context* ctx, void* scratch, size_t scratch
     memset(ctx->joint_slot, SP_MESHLET_NO_SLOT, SP_JOINT_SLOT_COUNT);
     ctx->builder_scratch = cursor;
     ctx->builder_scratch_size = scratch_size - (size_t)(cursor - (unsigned char*)scratch);
-}
-
-#define EMPTY_SLOT UINT64_MAX
-
-size_t sp_meshlet_tuple_set_slots(size_t vertex_count)
-{
-    size_t slots = 16;
-    while (slots < vertex_count * 2)
-        slots *= 2;
-    return slots;
-}
-
-size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32_t* ids)
-{
-    size_t k = ctx->influences, slots = sp_meshlet_tuple_set_slots(ctx->vertex_count), unique = 0;
-    int saw_empty_key = 0; /* four joints 0xffff would read as an empty slot: id `slots`, counted apart */
-    memset(set, 0xff, slots * sizeof(uint64_t));
-    for (size_t v = 0; v < ctx->vertex_count; ++v) {
-        uint64_t key = 0;
-        for (size_t s = 0; s < k; ++s)
-            key = key << 16 | (ctx->weights[v * k + s] > 0.0f ? ctx->joints[v * k + s] : 0u);
-        size_t at = slots;
-        if (key == EMPTY_SLOT) {
-            unique += !saw_empty_key;
-            saw_empty_key = 1;
-        } else {
-            at = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
-            while (set[at] != EMPTY_SLOT && set[at] != key)
-                at = (at + 1) & (slots - 1);
-            if (set[at] == EMPTY_SLOT) {
-                set[at] = key;
-                ++unique;
-            }
-        }
-        if (ids)
-            ids[v] = (uint32_t)at;
-    }
-    return unique;
 }
 
 static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)

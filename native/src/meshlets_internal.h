@@ -37,7 +37,6 @@ typedef struct sp_meshlet_context {
     uint32_t open_vertices[SP_MESHLET_MAX_VERTICES];
     uint16_t open_joints[SP_MESHLET_MAX_JOINTS];
     uint32_t open_triangle_count, open_vertex_count, open_joint_count;
-    float open_position_sum[3]; /* sum of the open vertices' positions: their centroid drives proximity */
 
     /* output */
     size_t global_tuples; /* the mesh's unique tuples once a builder has counted them, else 0 */

@@ -1,6 +1,8 @@
 /* joint_bound.c - see joint_bound.h. The three counts, for a split into meshlets of at most
  * max_vertices vertices and max_triangles triangles, each triangle in exactly one meshlet:
  *
+ * Only referenced vertices (used by some triangle) count: an unused vertex is in no meshlet.
+ *
  * - by joint: joint j is in the palette of every meshlet that holds one of the V_j vertices it
  *   weights or one of the T_j triangles touching them, so in at least
  *   need_j = max(ceil(V_j / max_vertices), ceil(T_j / max_triangles)) palettes;
@@ -134,10 +136,17 @@ int joint_bound_compute(const meshlet_input* in, size_t max_vertices, size_t max
     size_t* parent = malloc(joint_slots * sizeof(size_t));
     size_t* group_triangles = malloc(joint_slots * sizeof(size_t));
     size_t* pairs = malloc((triangle_count * 6 + 1) * sizeof(size_t));
-    int ok = joint_vertices && joint_triangles && need && parent && group_triangles && pairs && in->influences <= 8;
+    unsigned char* referenced = calloc(in->vertex_count + 1, 1);
+    int ok = joint_vertices && joint_triangles && need && parent && group_triangles && pairs && referenced &&
+             in->influences <= 8;
     if (ok) {
         uint16_t joints[3 * 8];
+        /* only vertices that a triangle uses reach a meshlet, so only they count */
+        for (size_t i = 0; i < in->index_count; ++i)
+            referenced[in->indices[i]] = 1;
         for (size_t v = 0; v < in->vertex_count; ++v) {
+            if (!referenced[v])
+                continue;
             size_t used = vertex_joints(in, v, joints);
             for (size_t i = 0; i < used; ++i) {
                 joint_vertices[joints[i]]++;
@@ -169,5 +178,6 @@ int joint_bound_compute(const meshlet_input* in, size_t max_vertices, size_t max
     free(parent);
     free(group_triangles);
     free(pairs);
+    free(referenced);
     return ok;
 }
