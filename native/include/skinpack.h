@@ -323,6 +323,10 @@ typedef struct sp_meshlet_options {
 /* Fills the defaults listed above. */
 SP_API void sp_meshlet_options_default(sp_meshlet_options* options);
 
+/* SP_OK if every field is in the range listed above (what sp_build_meshlets accepts), else
+ * SP_ERR_INVALID_ARGUMENT. Front ends call it to refuse bad limits before any work. */
+SP_API sp_result sp_check_meshlet_options(const sp_meshlet_options* options);
+
 /*
  * One meshlet. Its data lies in the shared arrays of sp_meshlet_buffers:
  *   vertices[vertex_offset + i], vertex_tuples[vertex_offset + i]  (i < vertex_count)

@@ -68,8 +68,10 @@ void sp_meshlets_bound(size_t index_count, size_t vertex_count, size_t influence
                            builder_scratch_bound(options->builder, triangle_count, vertex_count);
 }
 
-static sp_result check_options(const sp_meshlet_options* o)
+sp_result sp_check_meshlet_options(const sp_meshlet_options* o)
 {
+    if (!o)
+        return SP_ERR_INVALID_ARGUMENT;
     if (o->builder >= SP_MESHLETS_BUILDER_COUNT || o->max_vertices < 3 || o->max_vertices > SP_MESHLET_MAX_VERTICES ||
         o->max_triangles < 1 || o->max_triangles > SP_MESHLET_MAX_TRIANGLES || o->max_joints < 1 ||
         o->max_joints > SP_MESHLET_MAX_JOINTS || !(o->joint_cost >= 0.0f && o->joint_cost <= 1000.0f) ||
@@ -174,7 +176,7 @@ sp_result sp_build_meshlets(const uint32_t* indices, size_t index_count, const f
         index_count % 3 != 0 || vertex_count == 0 || vertex_positions_stride < 12 || vertex_positions_stride % 4 != 0 ||
         influences < 1 || influences > SP_MAX_INFLUENCES || index_count / 3 > UINT32_MAX)
         return SP_ERR_INVALID_ARGUMENT;
-    sp_result result = check_options(options);
+    sp_result result = sp_check_meshlet_options(options);
     if (result != SP_OK)
         return result;
 
