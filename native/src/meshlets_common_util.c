@@ -275,7 +275,12 @@ void sp_meshlet_flush(sp_meshlet_context* ctx)
     ctx->used.triangles += ctx->open_triangle_count;
     ctx->used.joints += ctx->open_joint_count;
 
-    /* empty the open meshlet: only the touched slots are reset, so a flush costs O(meshlet) */
+    sp_meshlet_reset_open(ctx);
+}
+
+void sp_meshlet_reset_open(sp_meshlet_context* ctx)
+{
+    /* only the touched slots are reset, so emptying costs O(meshlet) */
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i)
         ctx->vertex_slot[ctx->open_vertices[i]] = SP_MESHLET_NO_SLOT;
     for (uint32_t i = 0; i < ctx->open_joint_count; ++i)

@@ -88,6 +88,33 @@ int sp_meshlet_fits(const sp_meshlet_context* ctx, size_t t);
 void sp_meshlet_add(sp_meshlet_context* ctx, size_t t);
 /* Writes the open meshlet (if it has triangles) to the output and empties it. */
 void sp_meshlet_flush(sp_meshlet_context* ctx);
+/* Empties the open meshlet without writing it. */
+void sp_meshlet_reset_open(sp_meshlet_context* ctx);
+
+/* A split recorded as triangle lists before it is written (meshlets_merge.c): the skin builder
+ * closes its meshlets into a plan, merges underfull ones, then writes the plan. */
+typedef struct sp_meshlet_plan {
+    uint32_t* order;          /* triangles, meshlet by meshlet */
+    uint32_t* start;          /* meshlet m: order[start[m] .. start[m + 1]) */
+    uint32_t* next;           /* next meshlet merged into m's group, or UINT32_MAX */
+    uint32_t* tail;           /* last meshlet of m's group */
+    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order */
+    uint16_t* vertex_count;   /* as closed */
+    uint16_t* triangle_count; /* of m's group */
+    uint8_t* merged;          /* 1: m went into another meshlet's group */
+    uint64_t* keys;           /* scratch: sort keys */
+    size_t count;
+} sp_meshlet_plan;
+
+size_t sp_meshlet_plan_scratch_bound(size_t triangle_count);
+void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count);
+/* Records the open meshlet (if it has triangles) as the plan's next one and empties it. */
+void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
+/* Merges underfull meshlets with near ones they fit with (rank: triangle -> Morton position). */
+void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* rank);
+/* Writes every group of the plan as one meshlet. */
+void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
+
 /* Greedy in the given order (NULL: index order): close the meshlet when the next triangle does
  * not fit. Flushes at the end. This is the thesis's GenerateMeshlets. */
 void sp_meshlet_greedy(sp_meshlet_context* ctx, const uint32_t* order, size_t count);

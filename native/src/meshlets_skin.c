@@ -46,6 +46,7 @@ typedef struct skin_state {
     float corner[3];            /* low corner of the triangle centroids' box: seeds sweep away from it */
     uint32_t seeds[SEED_POOL];  /* free triangles on the borders of finished meshlets */
     uint32_t seed_count;
+    sp_meshlet_plan plan;       /* the meshlets closed so far, written at the end */
     float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
 } skin_state;
 
@@ -61,7 +62,7 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
            align8(vertex_count * sizeof(uint32_t)) + align8(triangle_count) + align8(triangle_count * 3 * sizeof(float)) +
            align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t)) +
            align8(vertex_count * sizeof(uint32_t)) + align8((tuple_slots + 1) * sizeof(uint32_t)) +
-           align8(tuple_slots * sizeof(uint64_t));
+           align8(tuple_slots * sizeof(uint64_t)) + sp_meshlet_plan_scratch_bound(triangle_count);
 }
 
 static void* carve(unsigned char** cursor, size_t bytes)
@@ -215,8 +216,8 @@ static seed make_seed(const sp_meshlet_context* ctx, const skin_state* s, uint32
 
 static int better_seed(const seed* a, const seed* b)
 {
-    if (b->triangle == NO_TRIANGLE)
-        return 1;
+    if (a->triangle == NO_TRIANGLE || b->triangle == NO_TRIANGLE)
+        return b->triangle == NO_TRIANGLE && a->triangle != NO_TRIANGLE;
     if (a->enclosure != b->enclosure)
         return a->enclosure < b->enclosure;
     if (a->corner_distance != b->corner_distance)
@@ -239,8 +240,10 @@ static void prune_seeds(skin_state* s)
 static void add_border_seeds(const sp_meshlet_context* ctx, skin_state* s)
 {
     seed best[SEEDS_PER_MESHLET];
-    for (int i = 0; i < SEEDS_PER_MESHLET; ++i)
-        best[i].triangle = NO_TRIANGLE;
+    for (int i = 0; i < SEEDS_PER_MESHLET; ++i) {
+        seed none = {NO_TRIANGLE, 0, 0.0f};
+        best[i] = none;
+    }
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
         uint32_t v = ctx->open_vertices[i];
         const uint32_t* list = s->adjacency + s->adjacency_offset[v];
@@ -284,7 +287,7 @@ static uint32_t pick_seed(const sp_meshlet_context* ctx, skin_state* s)
 static void flush(sp_meshlet_context* ctx, skin_state* s)
 {
     add_border_seeds(ctx, s);
-    sp_meshlet_flush(ctx);
+    sp_meshlet_plan_close(ctx, &s->plan);
     s->centroid_sum[0] = s->centroid_sum[1] = s->centroid_sum[2] = 0.0f;
     s->open_stamp++;
     s->open_tuple_count = 0;
@@ -438,6 +441,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.open_tuple_count = 0;
     s.seed_count = 0;
     s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
+    sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     build_spatial_order(ctx, &s);
@@ -475,5 +479,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         }
         emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
     }
-    sp_meshlet_flush(ctx);
+    sp_meshlet_plan_close(ctx, &s.plan);
+    sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
+    sp_meshlet_plan_write(ctx, &s.plan);
 }
