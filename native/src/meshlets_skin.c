@@ -370,8 +370,9 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
-            float cost = priority + ctx->options.joint_cost * (float)new_joints +
-                         ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
+            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            if (ctx->options.tuple_cost > 0.0f)
+                cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             candidate c = {t, cost, distance_to(s, t, point)};

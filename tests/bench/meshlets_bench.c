@@ -36,6 +36,7 @@ typedef struct row {
     uint32_t max_joints;
     size_t over16, over32; /* meshlets whose palette has more than 16 / 32 joints */
     double local_bits;     /* mean over meshlet vertex entries of the meshlet's local tuple bits */
+    size_t joint_floor;    /* sum over meshlets of the most joints any one of its vertices has */
     double ms;             /* fastest build, wall clock */
 } row;
 
@@ -52,8 +53,9 @@ static double wall_ms(void)
 
 /* Palette size and local tuple bits of one vertex list, by the rules of sp_build_meshlets. */
 static void analyse_vertices(const mesh_data* mesh, const uint32_t* vertices, size_t count, uint32_t* joints,
-                             uint32_t* tuple_bits)
+                             uint32_t* tuple_bits, uint32_t* floor)
 {
+    *floor = 0;
     static uint16_t slot[65536]; /* palette index + 1; 0 = absent */
     uint16_t palette[1024];
     uint32_t tuples[256];
@@ -65,6 +67,7 @@ static void analyse_vertices(const mesh_data* mesh, const uint32_t* vertices, si
             if (!(mesh->weights[v * k + s] > 0.0f))
                 continue;
             uint16_t j = mesh->joints[v * k + s];
+            *floor = (uint32_t)s + 1 > *floor ? (uint32_t)s + 1 : *floor; /* prepared: distinct, weight-sorted */
             if (!slot[j]) {
                 palette[palette_size] = j;
                 slot[j] = (uint16_t)++palette_size;
@@ -89,12 +92,13 @@ static void analyse_split(row* r, const mesh_data* mesh, const uint32_t* vertice
     size_t vertex_entries = 0;
     double bits_total = 0.0;
     r->meshlets = count;
-    r->palette_entries = r->over16 = r->over32 = 0;
+    r->palette_entries = r->over16 = r->over32 = r->joint_floor = 0;
     r->max_joints = 0;
     for (size_t m = 0; m < count; ++m) {
-        uint32_t joints, bits;
-        analyse_vertices(mesh, vertices + meshlets[m].offset, meshlets[m].count, &joints, &bits);
+        uint32_t joints, bits, floor;
+        analyse_vertices(mesh, vertices + meshlets[m].offset, meshlets[m].count, &joints, &bits, &floor);
         r->palette_entries += joints;
+        r->joint_floor += floor;
         r->max_joints = joints > r->max_joints ? joints : r->max_joints;
         r->over16 += joints > 16;
         r->over32 += joints > 32;
@@ -119,7 +123,7 @@ static row bench_meshopt_018(const mesh_data* mesh, uint32_t max_triangles, int 
     span* spans = malloc(bound * sizeof(span));
     if (!meshlets || !vertices || !triangles || !spans)
         die("meshopt 0.18", "out of memory");
-    row r = {"meshopt_buildMeshlets 0.18 (Debian)", 0, 0, 0, 0, 0, 0, 1e30};
+    row r = {"meshopt_buildMeshlets 0.18 (Debian)", 0, 0, 0, 0, 0, 0, 0, 1e30};
     size_t count = 0;
     for (int i = 0; i < reps; ++i) {
         double start = wall_ms();
@@ -152,7 +156,7 @@ static row bench_meshopt_13(const mesh_data* mesh, const char* node, const char*
     if (!p || !fgets(line, sizeof(line), p))
         die("meshoptimizer 1.3 (node)", command);
     int status = pclose(p);
-    row r = {"", 0, 0, 0, 0, 0, 0, 0};
+    row r = {"", 0, 0, 0, 0, 0, 0, 0, 0};
     const char* v = strstr(line, "\"version\":\"");
     const char* ms = strstr(line, "\"ms\":");
     if (status != 0 || !v || !ms || sscanf(v + 11, "%31[^\"]", version) != 1 || sscanf(ms + 5, "%lf", &r.ms) != 1)
@@ -194,7 +198,7 @@ static row bench_ours(const mesh_data* mesh, const char* name, uint32_t builder,
                         mesh->weights, mesh->influences};
     sp_meshlet_options o = meshlet_options(builder, MAX_VERTICES, max_triangles, palette);
     meshlet_run run;
-    row r = {"", 0, 0, 0, 0, 0, 0, 1e30};
+    row r = {"", 0, 0, 0, 0, 0, 0, 0, 1e30};
     snprintf(r.builder, sizeof(r.builder), "%s, palette cap %u", name, palette);
     meshlet_run_build(&run, &in, &o); /* allocates; the timed calls reuse the buffers */
     for (int i = 0; i < reps; ++i) {
@@ -228,10 +232,10 @@ static row bench_ours(const mesh_data* mesh, const char* name, uint32_t builder,
 
 static void print_row(FILE* f, const row* r, const row* reference)
 {
-    fprintf(f, "| %s | %zu | %.3f | %zu | %.3f | %u | %zu | %zu | %.2f | %.1f | %.2f |\n", r->builder, r->meshlets,
-            (double)r->meshlets / reference->meshlets, r->palette_entries,
-            (double)r->palette_entries / reference->palette_entries, r->max_joints, r->over16, r->over32,
-            r->local_bits, r->ms, r->ms / reference->ms);
+    fprintf(f, "| %s | %zu | %.3f | %zu | %.3f | %zu | %u | %zu | %zu | %.2f | %.1f | %.2f |\n", r->builder,
+            r->meshlets, (double)r->meshlets / reference->meshlets, r->palette_entries,
+            (double)r->palette_entries / reference->palette_entries, r->joint_floor, r->max_joints, r->over16,
+            r->over32, r->local_bits, r->ms, r->ms / reference->ms);
 }
 
 typedef struct bench_args {
@@ -306,8 +310,8 @@ static void bench_mesh(const bench_args* args, const char* name, const char* pat
             "\n### %s, %d vertices / %u triangles (%zu triangles, %zu vertices, %zu joints)\n\n"
             "Palette entries summed over meshlets, any split within these limits: at least %zu (by joint %zu + "
             "forced splits %zu; by influence count %zu).\n\n"
-            "| builder | meshlets | ÷ mo 1.3 | palette entries | ÷ mo 1.3 | max joints | meshlets over 16 | over 32 "
-            "| local tuple bits/vertex | ms | time ÷ mo 1.3 |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+            "| builder | meshlets | ÷ mo 1.3 | palette entries | ÷ mo 1.3 | joint floor | max joints | meshlets over 16 "
+            "| over 32 | local tuple bits/vertex | ms | time ÷ mo 1.3 |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
             name, MAX_VERTICES, max_triangles, mesh->index_count / 3, mesh->vertex_count, mesh->joint_count,
             bound.palette_sum, bound.by_joint, bound.forced_splits, bound.by_influence_count);
     for (int r = 0; r < n; ++r)
