@@ -376,6 +376,9 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             candidate c = {t, cost, distance_to(s, t, point)};
+            if (cost == 0.0f && (!require_fit || ctx->open_triangle_count < ctx->options.max_triangles))
+                return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
+                           * such triangles join does not change the meshlet */
             if (better(&c, &best))
                 best = c;
         }
