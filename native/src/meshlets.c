@@ -18,15 +18,11 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->tuple_cost = 0.0f;
 }
 
-static size_t align8(size_t bytes)
-{
-    return (bytes + 7) & ~(size_t)7;
-}
-
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles)
 {
-    return align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) + align8(triangle_count) +
-           align8(vertex_count) + align8(SP_JOINT_SLOT_COUNT) + align8(max_triangles * sizeof(uint32_t));
+    return sp_meshlet_align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) +
+           sp_meshlet_align8(triangle_count) + sp_meshlet_align8(vertex_count) + sp_meshlet_align8(SP_JOINT_SLOT_COUNT) +
+           sp_meshlet_align8(max_triangles * sizeof(uint32_t));
 }
 
 static size_t stats_scratch_bound(size_t vertex_count)
@@ -91,22 +87,15 @@ static sp_result check_capacity(const sp_meshlet_buffers* out, const sp_meshlet_
     return SP_OK;
 }
 
-static void* carve(unsigned char** cursor, size_t bytes)
-{
-    void* block = *cursor;
-    *cursor += align8(bytes);
-    return block;
-}
-
 static void setup_scratch(sp_meshlet_context* ctx, void* scratch, size_t scratch_size)
 {
     unsigned char* cursor = (unsigned char*)scratch;
     size_t t = ctx->triangle_count;
-    ctx->triangle_joints = carve(&cursor, t * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
-    ctx->triangle_joint_count = carve(&cursor, t);
-    ctx->vertex_slot = carve(&cursor, ctx->vertex_count);
-    ctx->joint_slot = carve(&cursor, SP_JOINT_SLOT_COUNT);
-    ctx->open_triangles = carve(&cursor, ctx->options.max_triangles * sizeof(uint32_t));
+    ctx->triangle_joints = sp_meshlet_carve(&cursor, t * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
+    ctx->triangle_joint_count = sp_meshlet_carve(&cursor, t);
+    ctx->vertex_slot = sp_meshlet_carve(&cursor, ctx->vertex_count);
+    ctx->joint_slot = sp_meshlet_carve(&cursor, SP_JOINT_SLOT_COUNT);
+    ctx->open_triangles = sp_meshlet_carve(&cursor, ctx->options.max_triangles * sizeof(uint32_t));
     memset(ctx->vertex_slot, SP_MESHLET_NO_SLOT, ctx->vertex_count);
     memset(ctx->joint_slot, SP_MESHLET_NO_SLOT, SP_JOINT_SLOT_COUNT);
     ctx->builder_scratch = cursor;

@@ -48,6 +48,19 @@ typedef struct sp_meshlet_context {
     size_t builder_scratch_size;
 } sp_meshlet_context;
 
+/* Scratch is carved into blocks of 8-byte multiples, so every block stays 8-byte aligned. */
+static inline size_t sp_meshlet_align8(size_t bytes)
+{
+    return (bytes + 7) & ~(size_t)7;
+}
+
+static inline void* sp_meshlet_carve(unsigned char** cursor, size_t bytes)
+{
+    void* block = *cursor;
+    *cursor += sp_meshlet_align8(bytes);
+    return block;
+}
+
 /* Scratch bytes the common part needs, and what each builder needs on top of it. */
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles);
 size_t sp_meshlet_common_builder_scratch_bound(size_t triangle_count);

@@ -17,38 +17,26 @@
 #define MERGE_WINDOW 8         /* underfull neighbours tried on each side */
 #define NO_MESHLET UINT32_MAX
 
-static size_t align8(size_t bytes)
-{
-    return (bytes + 7) & ~(size_t)7;
-}
-
 size_t sp_meshlet_plan_scratch_bound(size_t triangle_count)
 {
     size_t m = triangle_count; /* a meshlet has at least one triangle */
-    return align8(triangle_count * sizeof(uint32_t)) + align8((m + 1) * sizeof(uint32_t)) +
-           3 * align8(m * sizeof(uint32_t)) + 2 * align8(m * sizeof(uint16_t)) + align8(m) +
-           align8(m * sizeof(uint64_t));
-}
-
-static void* carve(unsigned char** cursor, size_t bytes)
-{
-    void* block = *cursor;
-    *cursor += align8(bytes);
-    return block;
+    return sp_meshlet_align8(triangle_count * sizeof(uint32_t)) + sp_meshlet_align8((m + 1) * sizeof(uint32_t)) +
+           3 * sp_meshlet_align8(m * sizeof(uint32_t)) + 2 * sp_meshlet_align8(m * sizeof(uint16_t)) +
+           sp_meshlet_align8(m) + sp_meshlet_align8(m * sizeof(uint64_t));
 }
 
 void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count)
 {
     size_t m = triangle_count;
-    plan->order = carve(cursor, triangle_count * sizeof(uint32_t));
-    plan->start = carve(cursor, (m + 1) * sizeof(uint32_t));
-    plan->next = carve(cursor, m * sizeof(uint32_t));
-    plan->tail = carve(cursor, m * sizeof(uint32_t));
-    plan->spatial = carve(cursor, m * sizeof(uint32_t));
-    plan->vertex_count = carve(cursor, m * sizeof(uint16_t));
-    plan->triangle_count = carve(cursor, m * sizeof(uint16_t));
-    plan->merged = carve(cursor, m);
-    plan->keys = carve(cursor, m * sizeof(uint64_t));
+    plan->order = sp_meshlet_carve(cursor, triangle_count * sizeof(uint32_t));
+    plan->start = sp_meshlet_carve(cursor, (m + 1) * sizeof(uint32_t));
+    plan->next = sp_meshlet_carve(cursor, m * sizeof(uint32_t));
+    plan->tail = sp_meshlet_carve(cursor, m * sizeof(uint32_t));
+    plan->spatial = sp_meshlet_carve(cursor, m * sizeof(uint32_t));
+    plan->vertex_count = sp_meshlet_carve(cursor, m * sizeof(uint16_t));
+    plan->triangle_count = sp_meshlet_carve(cursor, m * sizeof(uint16_t));
+    plan->merged = sp_meshlet_carve(cursor, m);
+    plan->keys = sp_meshlet_carve(cursor, m * sizeof(uint64_t));
     plan->count = 0;
     plan->start[0] = 0;
 }

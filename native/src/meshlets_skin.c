@@ -14,7 +14,9 @@
  * least enclosed seed (fewest free triangles around its corners, then nearest the mesh's low
  * corner), so meshlets sweep across the surface and leave no slivers behind. When the surface
  * patch runs out, the nearest free triangle (searched in a widening window of the Morton order
- * of triangle centroids, where meshoptimizer uses a k-d tree) continues it.
+ * of triangle centroids, where meshoptimizer uses a k-d tree) continues it. Meshlets are
+ * recorded as a plan and written at the end, after underfull ones are merged
+ * (meshlets_merge.c).
  */
 #include "meshlets_internal.h"
 
@@ -50,26 +52,19 @@ typedef struct skin_state {
     float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
 } skin_state;
 
-static size_t align8(size_t bytes)
-{
-    return (bytes + 7) & ~(size_t)7;
-}
-
 size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
 {
     size_t tuple_slots = sp_meshlet_tuple_set_slots(vertex_count);
-    return align8((vertex_count + 1) * sizeof(uint32_t)) + align8(triangle_count * 3 * sizeof(uint32_t)) +
-           align8(vertex_count * sizeof(uint32_t)) + align8(triangle_count) + align8(triangle_count * 3 * sizeof(float)) +
-           align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t)) +
-           align8(vertex_count * sizeof(uint32_t)) + align8((tuple_slots + 1) * sizeof(uint32_t)) +
-           align8(tuple_slots * sizeof(uint64_t)) + sp_meshlet_plan_scratch_bound(triangle_count);
-}
-
-static void* carve(unsigned char** cursor, size_t bytes)
-{
-    void* block = *cursor;
-    *cursor += align8(bytes);
-    return block;
+    size_t per_vertex = sp_meshlet_align8((vertex_count + 1) * sizeof(uint32_t)) + /* adjacency_offset */
+                        2 * sp_meshlet_align8(vertex_count * sizeof(uint32_t));     /* live, vertex_tuple */
+    size_t per_triangle = sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + /* adjacency */
+                          sp_meshlet_align8(triangle_count) +                        /* emitted */
+                          sp_meshlet_align8(triangle_count * 3 * sizeof(float)) +    /* centroid */
+                          sp_meshlet_align8(triangle_count * sizeof(uint64_t)) +     /* morton */
+                          sp_meshlet_align8(triangle_count * sizeof(uint32_t));      /* rank */
+    size_t tuples = sp_meshlet_align8((tuple_slots + 1) * sizeof(uint32_t)) + /* tuple_stamp */
+                    sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
+    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count);
 }
 
 /* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
@@ -376,7 +371,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             candidate c = {t, cost, distance_to(s, t, point)};
-            if (cost == 0.0f && (!require_fit || ctx->open_triangle_count < ctx->options.max_triangles))
+            if (cost == 0.0f)
                 return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
                            * such triangles join does not change the meshlet */
             if (better(&c, &best))
@@ -427,19 +422,20 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     unsigned char* cursor = ctx->builder_scratch;
     size_t t_count = ctx->triangle_count, v_count = ctx->vertex_count;
     skin_state s;
-    s.adjacency_offset = carve(&cursor, (v_count + 1) * sizeof(uint32_t));
-    s.adjacency = carve(&cursor, t_count * 3 * sizeof(uint32_t));
-    s.live = carve(&cursor, v_count * sizeof(uint32_t));
-    s.emitted = carve(&cursor, t_count);
-    s.centroid = carve(&cursor, t_count * 3 * sizeof(float));
-    s.morton = carve(&cursor, t_count * sizeof(uint64_t));
-    s.rank = carve(&cursor, t_count * sizeof(uint32_t));
+    s.adjacency_offset = sp_meshlet_carve(&cursor, (v_count + 1) * sizeof(uint32_t));
+    s.adjacency = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(uint32_t));
+    s.live = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
+    s.emitted = sp_meshlet_carve(&cursor, t_count);
+    s.centroid = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(float));
+    s.morton = sp_meshlet_carve(&cursor, t_count * sizeof(uint64_t));
+    s.rank = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
     s.seed_cursor = 0;
     s.last_rank = 0;
-    s.vertex_tuple = carve(&cursor, v_count * sizeof(uint32_t));
+    s.vertex_tuple = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
     size_t tuple_slots = sp_meshlet_tuple_set_slots(v_count);
-    s.tuple_stamp = carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
-    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, carve(&cursor, tuple_slots * sizeof(uint64_t)), s.vertex_tuple);
+    s.tuple_stamp = sp_meshlet_carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
+    uint64_t* tuple_set = sp_meshlet_carve(&cursor, tuple_slots * sizeof(uint64_t));
+    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, tuple_set, s.vertex_tuple);
     memset(s.tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
     s.open_stamp = 1;
     s.open_tuple_count = 0;

@@ -31,7 +31,7 @@ enum { MAX_VERTICES = 64, ROWS = 6 };
 static const uint32_t triangle_limits[] = {124, 126};
 
 typedef struct row {
-    char builder[64];
+    char builder[96];
     size_t meshlets, palette_entries;
     uint32_t max_joints;
     size_t over16, over32; /* meshlets whose palette has more than 16 / 32 joints */
