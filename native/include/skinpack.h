@@ -316,7 +316,7 @@ typedef struct sp_meshlet_options {
     uint32_t max_triangles;       /* 1..512, default 124 */
     uint32_t max_joints;          /* palette limit 1..255, default 32; every builder respects it */
     uint32_t min_group_triangles; /* SP_MESHLETS_COMMON: smaller groups go to the remainder; default 16 */
-    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 0.25 */
+    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 0 */
     float tuple_cost;             /* SP_MESHLETS_SKIN: cost of one new local LUT tuple in new vertices, 0..1000; default 0 */
 } sp_meshlet_options;
 

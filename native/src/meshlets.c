@@ -14,7 +14,7 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->max_triangles = 124;
     options->max_joints = 32;
     options->min_group_triangles = 16;
-    options->joint_cost = 0.25f;
+    options->joint_cost = 0.0f;
     options->tuple_cost = 0.0f;
 }
 

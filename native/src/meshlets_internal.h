@@ -117,6 +117,10 @@ typedef struct sp_meshlet_plan {
     uint8_t* merged;          /* 1: m went into another meshlet's group */
     uint64_t* keys;           /* scratch: sort keys */
     size_t count;
+    /* after sp_meshlet_plan_link: each group's triangles as a list, named by the group's first meshlet */
+    uint32_t* owner;          /* per triangle: its group */
+    uint32_t* next_triangle;  /* per triangle: the next one of its group, or UINT32_MAX */
+    uint32_t* first_triangle; /* per group */
 } sp_meshlet_plan;
 
 size_t sp_meshlet_plan_scratch_bound(size_t triangle_count);
@@ -125,7 +129,16 @@ void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t 
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
 /* Merges underfull meshlets with near ones they fit with (rank: triangle -> Morton position). */
 void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* rank);
-/* Writes every group of the plan as one meshlet. */
+/* meshlets_refine.c: turns the merged groups into triangle lists; then removes meshlets whose
+ * triangles all fit into neighbouring meshlets (vertex_adjacency_offset/vertex_adjacency: the
+ * triangles around each vertex, as the skin builder keeps them); then moves border triangles
+ * to the neighbour where they cost fewer palette entries. Never over a limit. */
+void sp_meshlet_plan_link(sp_meshlet_plan* plan);
+void sp_meshlet_plan_dissolve(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
+                              const uint32_t* vertex_adjacency);
+void sp_meshlet_plan_refine(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
+                            const uint32_t* vertex_adjacency);
+/* Writes every group of the linked plan as one meshlet. */
 void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
 
 /* Greedy in the given order (NULL: index order): close the meshlet when the next triangle does

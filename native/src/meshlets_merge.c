@@ -22,7 +22,8 @@ size_t sp_meshlet_plan_scratch_bound(size_t triangle_count)
     size_t m = triangle_count; /* a meshlet has at least one triangle */
     return sp_meshlet_align8(triangle_count * sizeof(uint32_t)) + sp_meshlet_align8((m + 1) * sizeof(uint32_t)) +
            3 * sp_meshlet_align8(m * sizeof(uint32_t)) + 2 * sp_meshlet_align8(m * sizeof(uint16_t)) +
-           sp_meshlet_align8(m) + sp_meshlet_align8(m * sizeof(uint64_t));
+           sp_meshlet_align8(m) + sp_meshlet_align8(m * sizeof(uint64_t)) +
+           2 * sp_meshlet_align8(triangle_count * sizeof(uint32_t)) + sp_meshlet_align8(m * sizeof(uint32_t));
 }
 
 void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count)
@@ -37,6 +38,9 @@ void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t 
     plan->triangle_count = sp_meshlet_carve(cursor, m * sizeof(uint16_t));
     plan->merged = sp_meshlet_carve(cursor, m);
     plan->keys = sp_meshlet_carve(cursor, m * sizeof(uint64_t));
+    plan->owner = sp_meshlet_carve(cursor, triangle_count * sizeof(uint32_t));
+    plan->next_triangle = sp_meshlet_carve(cursor, triangle_count * sizeof(uint32_t));
+    plan->first_triangle = sp_meshlet_carve(cursor, m * sizeof(uint32_t));
     plan->count = 0;
     plan->start[0] = 0;
 }
@@ -130,13 +134,4 @@ void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const
     size_t count = list_underfull(ctx, plan, rank);
     for (size_t k = 0; k < count; ++k)
         merge_into_neighbour(ctx, plan, (uint32_t)plan->keys[k], count);
-}
-
-void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan)
-{
-    for (uint32_t m = 0; m < plan->count; ++m)
-        if (!plan->merged[m]) {
-            add_group(ctx, plan, m, 0);
-            sp_meshlet_flush(ctx);
-        }
 }

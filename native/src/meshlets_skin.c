@@ -481,5 +481,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     }
     sp_meshlet_plan_close(ctx, &s.plan);
     sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
+    sp_meshlet_plan_link(&s.plan);
+    sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
     sp_meshlet_plan_write(ctx, &s.plan);
 }
