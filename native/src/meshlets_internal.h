@@ -129,13 +129,11 @@ void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t 
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
 /* Merges underfull meshlets with near ones they fit with (rank: triangle -> Morton position). */
 void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* rank);
-/* meshlets_refine.c: turns the merged groups into triangle lists; then removes meshlets whose
- * triangles all fit into neighbouring meshlets (vertex_adjacency_offset/vertex_adjacency: the
- * triangles around each vertex, as the skin builder keeps them); then moves border triangles
- * to the neighbour where they cost fewer palette entries. Never over a limit. */
+/* meshlets_refine.c: turns the merged groups into triangle lists; then moves the few triangles
+ * that bring a joint into a meshlet to a neighbour where they cost fewer palette entries, never
+ * over a limit (vertex_adjacency_offset/vertex_adjacency: the triangles around each vertex, as
+ * the skin builder keeps them). */
 void sp_meshlet_plan_link(sp_meshlet_plan* plan);
-void sp_meshlet_plan_dissolve(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
-                              const uint32_t* vertex_adjacency);
 void sp_meshlet_plan_refine(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
                             const uint32_t* vertex_adjacency);
 /* Writes every group of the linked plan as one meshlet. */

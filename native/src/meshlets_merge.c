@@ -6,8 +6,8 @@
  * written); then each underfull meshlet, smallest first, is merged with the nearest underfull
  * meshlet (in the Morton order of their first triangles, a window on each side) that fits
  * together with it within every limit, the palette cap included. Every merge saves one meshlet
- * and never adds a palette entry (the union of two palettes is at most their sum). Finally the
- * plan is written out through the common sp_meshlet_add / sp_meshlet_flush.
+ * and never adds a palette entry (the union of two palettes is at most their sum). The plan is
+ * then refined and written out by meshlets_refine.c.
  */
 #include "meshlets_internal.h"
 

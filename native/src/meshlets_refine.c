@@ -1,26 +1,23 @@
 /*
- * meshlets_refine.c - the skin builder's last steps on its plan, after the merge of underfull
- * meshlets (meshlets_merge.c):
+ * meshlets_refine.c - the skin builder's last step on its plan, after the merge of underfull
+ * meshlets (meshlets_merge.c): lowering the sum of palette entries at the same meshlet count.
  *
- * 1. dissolve: a meshlet whose triangles all fit into the meshlets around it (each triangle next
- *    to the meshlet it joins, every limit kept, the palette cap included) is removed: smallest
- *    first, so the meshlets that greedy growth left small give their triangles to full-grown
- *    neighbours that still have a few vertices of room. Saves one meshlet per success.
- * 2. refine: for each palette joint of a meshlet that only a few of its triangles use, those
- *    triangles move to the neighbour meshlet that they fit into with fewest new joints, when that
- *    lowers the sum of palette entries (never over a limit, never a new meshlet).
+ * For each palette joint of a meshlet that only a few of its triangles carry, those triangles
+ * move to the neighbouring meshlet where the palette sum drops most (the joints the source
+ * loses minus the joints the target gains), if it drops; never over a limit (the target takes
+ * them through sp_meshlet_fits, the palette cap included), never a new meshlet. Greedy growth
+ * leaves such joints on meshlet borders: a triangle taken for its vertices that reaches one
+ * vertex of the next part.
  *
- * Both work on the plan's triangle lists (sp_meshlet_plan_link) and load one meshlet at a time
- * into the open meshlet of the context to check limits, as the builders do.
+ * Works on the plan's triangle lists (sp_meshlet_plan_link) and loads one meshlet at a time into
+ * the open meshlet of the context to count and check, as the builders do.
  */
 #include "meshlets_internal.h"
 
-#include <stdlib.h>
 #include <string.h>
 
 #define NO_TRIANGLE UINT32_MAX
 #define NEIGHBOUR_MAX 32      /* meshlets around one meshlet considered */
-#define DISSOLVE_ROUNDS 2     /* passes over the neighbours while triangles are left */
 #define REFINE_TRIANGLES 8    /* a joint used by more triangles of its meshlet is not moved */
 #define REFINE_PASSES 2
 
