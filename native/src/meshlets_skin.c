@@ -6,9 +6,10 @@
  * Grows one meshlet at a time like meshopt_buildMeshlets (1.x): the next triangle is the best
  * live triangle adjacent to the meshlet's vertices that fits every limit. A candidate costs its
  * topological priority (topology_priority) plus joint_cost per joint it would add to the
- * palette and tuple_cost per tuple its new vertices would add to the local LUT; with the
- * defaults (0.25 and 0) the joint term stays below one priority step, so it mostly breaks ties
- * between candidates of equal topology and keeps the count at meshoptimizer's. Ties go to the
+ * palette and tuple_cost per tuple its new vertices would add to the local LUT; both default to
+ * 0, because on the benchmark meshes even a joint tie-break (any joint_cost below one priority
+ * step) costs a few meshlets against the distance tie-break; the palette cap is enforced either
+ * way, and the refine step lowers the palette sum afterwards. Ties go to the
  * candidate nearest the centre of the meshlet's triangles. When no adjacent triangle fits, the
  * meshlet closes, leaves seed candidates on its border, and the next meshlet starts at the
  * least enclosed seed (fewest free triangles around its corners, then nearest the mesh's low
@@ -16,7 +17,8 @@
  * patch runs out, the nearest free triangle (searched in a widening window of the Morton order
  * of triangle centroids, where meshoptimizer uses a k-d tree) continues it. Meshlets are
  * recorded as a plan and written at the end, after underfull ones are merged
- * (meshlets_merge.c).
+ * (meshlets_merge.c) and border triangles moved where they cost fewer palette entries
+ * (meshlets_refine.c).
  */
 #include "meshlets_internal.h"
 
