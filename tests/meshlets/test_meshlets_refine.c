@@ -7,24 +7,13 @@
  * not when the vertex limit forbids it.
  */
 #include "meshlets_internal.h"
+#include "test_expect.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 enum { TRIANGLES = 12, VERTICES = TRIANGLES + 2 };
-
-static int failures;
-
-#define EXPECT(cond, ...)                                              \
-    do {                                                               \
-        if (!(cond)) {                                                 \
-            fprintf(stderr, "%s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                              \
-            fprintf(stderr, "\n");                                     \
-            failures++;                                                \
-        }                                                              \
-    } while (0)
 
 /* Builds the plan above with this vertex limit, refines it, returns the owner of triangle 5
  * and the group sizes of A and B. */
