@@ -169,6 +169,7 @@ int cli_check_meshlets(const gltf_doc* doc, const gltf_packed_skin* packed, size
         entries += vc;
     }
     summary->count = n;
+    summary->palette_entries = (size_t)joint_sum;
     summary->mean_joints = n ? joint_sum / (double)n : 0;
     summary->local_tuple_bits_mean = entries ? tuple_bits_sum / (double)entries : 0;
     rc = 0;

@@ -47,6 +47,7 @@ void cli_decoded_skin_free(cli_decoded_skin* skin);
 typedef struct cli_meshlet_summary {
     size_t count;
     uint32_t max_vertices, max_triangles, max_joints;
+    size_t palette_entries; /* palette joints summed over meshlets */
     double mean_joints;
     double local_tuple_bits_mean; /* mean over meshlet vertex entries of ceil(log2 tuple count) */
 } cli_meshlet_summary;

@@ -18,6 +18,8 @@ typedef struct compress_args {
     int compact;
     int json;
     int meshlets; /* --meshlets: also write skin-aware meshlets */
+    sp_meshlet_options meshlet_options; /* --meshlet-vertices/-triangles/-joints over the library's defaults */
+    const char* meshlet_limit;          /* the first of those options given, for the error without --meshlets */
 } compress_args;
 
 /* One primitive's outcome. Primitives with the same JOINTS_n/WEIGHTS_n accessors share the
@@ -35,6 +37,8 @@ typedef struct compressed_primitive {
 } compressed_primitive;
 
 static void compress_usage(FILE* out) {
+    sp_meshlet_options defaults;
+    sp_meshlet_options_default(&defaults);
     fprintf(out,
             "usage: skinpack compress IN -o OUT [options]\n"
             "  --method oss|any|pot|cube|fixed   weight codec (default oss)\n"
@@ -45,9 +49,14 @@ static void compress_usage(FILE* out) {
             "  --fallback           keep JOINTS_0/WEIGHTS_0, extension optional (default)\n"
             "  --compact            remove them, extension required\n"
             "  --meshlets           also store skin-aware meshlets (palettes, local tuple tables)\n"
+            "  --meshlet-vertices N   meshlet vertex limit, 3..%d (default %u)\n"
+            "  --meshlet-triangles N  meshlet triangle limit, 1..%d (default %u)\n"
+            "  --meshlet-joints N     palette cap: joints a meshlet may use, 1..%d (default %u)\n"
             "  --exact-tuples       no don't-care sharing: zero-weight slots keep their joints\n"
             "  --json               machine-readable report on stdout\n"
-            "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n");
+            "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n",
+            SP_MESHLET_MAX_VERTICES, defaults.max_vertices, SP_MESHLET_MAX_TRIANGLES, defaults.max_triangles,
+            SP_MESHLET_MAX_JOINTS, defaults.max_joints);
 }
 
 static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
@@ -58,14 +67,37 @@ static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
     return 0;
 }
 
+/* --meshlet-vertices/-triangles/-joints: 1 if a is one of them (value consumed), 0 if not, -1
+ * on a bad value. The ranges are the library's (sp_check_meshlet_options). */
+static int parse_meshlet_limit(const char* a, const char* value, compress_args* args) {
+    sp_meshlet_options* o = &args->meshlet_options;
+    uint32_t* field = strcmp(a, "--meshlet-vertices") == 0    ? &o->max_vertices
+                      : strcmp(a, "--meshlet-triangles") == 0 ? &o->max_triangles
+                      : strcmp(a, "--meshlet-joints") == 0    ? &o->max_joints
+                                                              : NULL;
+    if (!field || !value) return 0;
+    if (!args->meshlet_limit) args->meshlet_limit = a;
+    if (parse_uint(value, UINT32_MAX, field) || sp_check_meshlet_options(o) != SP_OK) {
+        fprintf(stderr, "skinpack compress: %s %s: vertices must be 3..%d, triangles 1..%d, joints 1..%d\n", a, value,
+                SP_MESHLET_MAX_VERTICES, SP_MESHLET_MAX_TRIANGLES, SP_MESHLET_MAX_JOINTS);
+        return -1;
+    }
+    return 1;
+}
+
 static int parse_args(int argc, char** argv, compress_args* args) {
     memset(args, 0, sizeof(*args));
     sp_compress_options_default(&args->options);
+    sp_meshlet_options_default(&args->meshlet_options);
     int budgets = 0;
     for (int i = 1; i < argc; ++i) {
         const char* a = argv[i];
         const char* value = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-o") == 0 && value) {
+        int limit = parse_meshlet_limit(a, value, args);
+        if (limit < 0) return -1;
+        if (limit > 0) {
+            ++i;
+        } else if (strcmp(a, "-o") == 0 && value) {
             args->output = value;
             ++i;
         } else if (strcmp(a, "--method") == 0 && value) {
@@ -128,6 +160,10 @@ static int parse_args(int argc, char** argv, compress_args* args) {
             args->input = a;
         }
     }
+    if (args->meshlet_limit && !args->meshlets) {
+        fprintf(stderr, "skinpack compress: %s needs --meshlets\n", args->meshlet_limit);
+        return -1;
+    }
     if (budgets > 1) {
         fprintf(stderr, "skinpack compress: give at most one of --vertex-bits, --weight-bits, --max-error\n");
         return -1;
@@ -179,7 +215,7 @@ static int weight_bits_for_error(const compress_args* args, const uint16_t* join
  * decoder will see (the packed data decoded again), stored as the extension's "meshlets".
  */
 static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t* words, const uint16_t* lut,
-                          char* err, size_t err_size) {
+                          const sp_meshlet_options* limits, char* err, size_t err_size) {
     const sp_compressed_skin* s = &p->skin;
     size_t index_count = 0, vertex_count = 0;
     if (gltf_primitive_triangles(doc, p->mesh, p->primitive, &index_count, &vertex_count, err, err_size)) return -1;
@@ -192,8 +228,7 @@ static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t
                                  &decoded, err, err_size))
         return -1;
     uint32_t k = s->influences;
-    sp_meshlet_options options;
-    sp_meshlet_options_default(&options);
+    sp_meshlet_options options = *limits;
     sp_meshlet_sizes sizes;
     sp_meshlets_bound(index_count, vertex_count, k, &options, &sizes);
     uint32_t* indices = malloc(index_count * sizeof(uint32_t));
@@ -223,7 +258,11 @@ static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t
     sp_result r = sp_build_meshlets(indices, index_count, positions, vertex_count, 3 * sizeof(float), decoded.joints,
                                     decoded.weights, k, &options, &out, scratch, sizes.scratch_bytes, stats);
     if (r != SP_OK) {
-        snprintf(err, err_size, "meshlets: %s (triangle %zu)", sp_result_string(r), stats->error_triangle);
+        if (r == SP_ERR_LIMIT_EXCEEDED)
+            snprintf(err, err_size, "meshlets: triangle %zu uses more joints than the palette cap %u (--meshlet-joints)",
+                     stats->error_triangle, options.max_joints);
+        else
+            snprintf(err, err_size, "meshlets: %s (triangle %zu)", sp_result_string(r), stats->error_triangle);
         goto done;
     }
     size_t n = stats->meshlet_count;
@@ -332,7 +371,7 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     p->packed.weight_bits = s->weight_bits;
     p->packed.tuple_bits = s->tuple_bits;
     p->packed.max_error = s->codec.max_error;
-    if (args->meshlets && build_meshlets(doc, p, words, lut, err, err_size)) goto done;
+    if (args->meshlets && build_meshlets(doc, p, words, lut, &args->meshlet_options, err, err_size)) goto done;
 
     size_t lut_entries = s->lut_size * k;
     int lut_type = GLTF_UNSIGNED_SHORT;
@@ -408,8 +447,8 @@ static void print_json(const compress_args* args, const compressed_primitive* pr
             printf(", \"meshlets\": {\"count\": %zu, \"max_vertices\": %u, \"max_triangles\": %u, \"mean_joints\": ",
                    ms->meshlet_count, ms->max_vertices, ms->max_triangles);
             cli_json_number(stdout, ms->mean_joints);
-            printf(", \"max_joints\": %u, \"global_tuple_bits\": %u, \"local_tuple_bits_mean\": ", ms->max_joints,
-                   s->tuple_bits);
+            printf(", \"max_joints\": %u, \"palette_entries\": %zu, \"global_tuple_bits\": %u, "
+                   "\"local_tuple_bits_mean\": ", ms->max_joints, ms->joint_count, s->tuple_bits);
             cli_json_number(stdout, ms->local_tuple_bits_mean);
             printf("}");
         }

@@ -215,8 +215,8 @@ static void print_json(const char* input, const primitive_info* infos, size_t co
                 printf(", \"meshlets\": {\"count\": %zu, \"max_vertices\": %u, \"max_triangles\": %u, "
                        "\"mean_joints\": ", ms->count, ms->max_vertices, ms->max_triangles);
                 cli_json_number(stdout, ms->mean_joints);
-                printf(", \"max_joints\": %u, \"global_tuple_bits\": %.0f, \"local_tuple_bits_mean\": ",
-                       ms->max_joints, p->tuple_bits);
+                printf(", \"max_joints\": %u, \"palette_entries\": %zu, \"global_tuple_bits\": %.0f, "
+                       "\"local_tuple_bits_mean\": ", ms->max_joints, ms->palette_entries, p->tuple_bits);
                 cli_json_number(stdout, ms->local_tuple_bits_mean);
                 printf("}");
             }

@@ -513,12 +513,16 @@ typedef struct sp_meshlet_options {
     uint32_t max_triangles;       /* 1..512, default 124 */
     uint32_t max_joints;          /* palette limit 1..255, default 32; every builder respects it */
     uint32_t min_group_triangles; /* SP_MESHLETS_COMMON: smaller groups go to the remainder; default 16 */
-    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 1 */
-    float tuple_cost;             /* SP_MESHLETS_SKIN: cost of one new local LUT tuple in new vertices, 0..1000; default 0.25 */
+    float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 0 */
+    float tuple_cost;             /* SP_MESHLETS_SKIN: cost of one new local LUT tuple in new vertices, 0..1000; default 0 */
 } sp_meshlet_options;
 
 /* Fills the defaults listed above. */
 SP_API void sp_meshlet_options_default(sp_meshlet_options* options);
+
+/* SP_OK if every field is in the range listed above (what sp_build_meshlets accepts), else
+ * SP_ERR_INVALID_ARGUMENT. Front ends call it to refuse bad limits before any work. */
+SP_API sp_result sp_check_meshlet_options(const sp_meshlet_options* options);
 
 /*
  * One meshlet. Its data lies in the shared arrays of sp_meshlet_buffers:

@@ -14,19 +14,15 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->max_triangles = 124;
     options->max_joints = 32;
     options->min_group_triangles = 16;
-    options->joint_cost = 1.0f;
-    options->tuple_cost = 0.25f;
-}
-
-static size_t align8(size_t bytes)
-{
-    return (bytes + 7) & ~(size_t)7;
+    options->joint_cost = 0.0f;
+    options->tuple_cost = 0.0f;
 }
 
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles)
 {
-    return align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) + align8(triangle_count) +
-           align8(vertex_count) + align8(SP_JOINT_SLOT_COUNT) + align8(max_triangles * sizeof(uint32_t));
+    return sp_meshlet_align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) +
+           sp_meshlet_align8(triangle_count) + sp_meshlet_align8(vertex_count) + sp_meshlet_align8(SP_JOINT_SLOT_COUNT) +
+           sp_meshlet_align8(max_triangles * sizeof(uint32_t));
 }
 
 static size_t stats_scratch_bound(size_t vertex_count)
@@ -68,8 +64,10 @@ void sp_meshlets_bound(size_t index_count, size_t vertex_count, size_t influence
                            builder_scratch_bound(options->builder, triangle_count, vertex_count);
 }
 
-static sp_result check_options(const sp_meshlet_options* o)
+sp_result sp_check_meshlet_options(const sp_meshlet_options* o)
 {
+    if (!o)
+        return SP_ERR_INVALID_ARGUMENT;
     if (o->builder >= SP_MESHLETS_BUILDER_COUNT || o->max_vertices < 3 || o->max_vertices > SP_MESHLET_MAX_VERTICES ||
         o->max_triangles < 1 || o->max_triangles > SP_MESHLET_MAX_TRIANGLES || o->max_joints < 1 ||
         o->max_joints > SP_MESHLET_MAX_JOINTS || !(o->joint_cost >= 0.0f && o->joint_cost <= 1000.0f) ||
@@ -89,64 +87,19 @@ static sp_result check_capacity(const sp_meshlet_buffers* out, const sp_meshlet_
     return SP_OK;
 }
 
-static void* carve(unsigned char** cursor, size_t bytes)
-{
-    void* block = *cursor;
-    *cursor += align8(bytes);
-    return block;
-}
-
 static void setup_scratch(sp_meshlet_context* ctx, void* scratch, size_t scratch_size)
 {
     unsigned char* cursor = (unsigned char*)scratch;
     size_t t = ctx->triangle_count;
-    ctx->triangle_joints = carve(&cursor, t * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
-    ctx->triangle_joint_count = carve(&cursor, t);
-    ctx->vertex_slot = carve(&cursor, ctx->vertex_count);
-    ctx->joint_slot = carve(&cursor, SP_JOINT_SLOT_COUNT);
-    ctx->open_triangles = carve(&cursor, ctx->options.max_triangles * sizeof(uint32_t));
+    ctx->triangle_joints = sp_meshlet_carve(&cursor, t * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
+    ctx->triangle_joint_count = sp_meshlet_carve(&cursor, t);
+    ctx->vertex_slot = sp_meshlet_carve(&cursor, ctx->vertex_count);
+    ctx->joint_slot = sp_meshlet_carve(&cursor, SP_JOINT_SLOT_COUNT);
+    ctx->open_triangles = sp_meshlet_carve(&cursor, ctx->options.max_triangles * sizeof(uint32_t));
     memset(ctx->vertex_slot, SP_MESHLET_NO_SLOT, ctx->vertex_count);
     memset(ctx->joint_slot, SP_MESHLET_NO_SLOT, SP_JOINT_SLOT_COUNT);
     ctx->builder_scratch = cursor;
     ctx->builder_scratch_size = scratch_size - (size_t)(cursor - (unsigned char*)scratch);
-}
-
-#define EMPTY_SLOT UINT64_MAX
-
-size_t sp_meshlet_tuple_set_slots(size_t vertex_count)
-{
-    size_t slots = 16;
-    while (slots < vertex_count * 2)
-        slots *= 2;
-    return slots;
-}
-
-size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32_t* ids)
-{
-    size_t k = ctx->influences, slots = sp_meshlet_tuple_set_slots(ctx->vertex_count), unique = 0;
-    int saw_empty_key = 0; /* four joints 0xffff would read as an empty slot: id `slots`, counted apart */
-    memset(set, 0xff, slots * sizeof(uint64_t));
-    for (size_t v = 0; v < ctx->vertex_count; ++v) {
-        uint64_t key = 0;
-        for (size_t s = 0; s < k; ++s)
-            key = key << 16 | (ctx->weights[v * k + s] > 0.0f ? ctx->joints[v * k + s] : 0u);
-        size_t at = slots;
-        if (key == EMPTY_SLOT) {
-            unique += !saw_empty_key;
-            saw_empty_key = 1;
-        } else {
-            at = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
-            while (set[at] != EMPTY_SLOT && set[at] != key)
-                at = (at + 1) & (slots - 1);
-            if (set[at] == EMPTY_SLOT) {
-                set[at] = key;
-                ++unique;
-            }
-        }
-        if (ids)
-            ids[v] = (uint32_t)at;
-    }
-    return unique;
 }
 
 static void fill_stats(const sp_meshlet_context* ctx, sp_meshlet_stats* stats)
@@ -212,7 +165,7 @@ sp_result sp_build_meshlets(const uint32_t* indices, size_t index_count, const f
         index_count % 3 != 0 || vertex_count == 0 || vertex_positions_stride < 12 || vertex_positions_stride % 4 != 0 ||
         influences < 1 || influences > SP_MAX_INFLUENCES || index_count / 3 > UINT32_MAX)
         return SP_ERR_INVALID_ARGUMENT;
-    sp_result result = check_options(options);
+    sp_result result = sp_check_meshlet_options(options);
     if (result != SP_OK)
         return result;
 

@@ -55,9 +55,6 @@ void sp_meshlet_add(sp_meshlet_context* ctx, size_t t)
             continue;
         ctx->vertex_slot[v] = (uint8_t)ctx->open_vertex_count;
         ctx->open_vertices[ctx->open_vertex_count++] = v;
-        const float* p = sp_meshlet_position(ctx, v);
-        for (int i = 0; i < 3; ++i)
-            ctx->open_position_sum[i] += p[i];
     }
     const uint16_t* list = ctx->triangle_joints + t * SP_MESHLET_TRIANGLE_JOINTS;
     for (uint32_t i = 0; i < ctx->triangle_joint_count[t]; ++i) {
@@ -278,13 +275,17 @@ void sp_meshlet_flush(sp_meshlet_context* ctx)
     ctx->used.triangles += ctx->open_triangle_count;
     ctx->used.joints += ctx->open_joint_count;
 
-    /* empty the open meshlet: only the touched slots are reset, so a flush costs O(meshlet) */
+    sp_meshlet_reset_open(ctx);
+}
+
+void sp_meshlet_reset_open(sp_meshlet_context* ctx)
+{
+    /* only the touched slots are reset, so emptying costs O(meshlet) */
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i)
         ctx->vertex_slot[ctx->open_vertices[i]] = SP_MESHLET_NO_SLOT;
     for (uint32_t i = 0; i < ctx->open_joint_count; ++i)
         ctx->joint_slot[ctx->open_joints[i]] = SP_MESHLET_NO_SLOT;
     ctx->open_vertex_count = ctx->open_triangle_count = ctx->open_joint_count = 0;
-    ctx->open_position_sum[0] = ctx->open_position_sum[1] = ctx->open_position_sum[2] = 0.0f;
 }
 
 void sp_meshlet_greedy(sp_meshlet_context* ctx, const uint32_t* order, size_t count)

@@ -37,7 +37,6 @@ typedef struct sp_meshlet_context {
     uint32_t open_vertices[SP_MESHLET_MAX_VERTICES];
     uint16_t open_joints[SP_MESHLET_MAX_JOINTS];
     uint32_t open_triangle_count, open_vertex_count, open_joint_count;
-    float open_position_sum[3]; /* sum of the open vertices' positions: their centroid drives proximity */
 
     /* output */
     size_t global_tuples; /* the mesh's unique tuples once a builder has counted them, else 0 */
@@ -48,6 +47,19 @@ typedef struct sp_meshlet_context {
     unsigned char* builder_scratch;
     size_t builder_scratch_size;
 } sp_meshlet_context;
+
+/* Scratch is carved into blocks of 8-byte multiples, so every block stays 8-byte aligned. */
+static inline size_t sp_meshlet_align8(size_t bytes)
+{
+    return (bytes + 7) & ~(size_t)7;
+}
+
+static inline void* sp_meshlet_carve(unsigned char** cursor, size_t bytes)
+{
+    void* block = *cursor;
+    *cursor += sp_meshlet_align8(bytes);
+    return block;
+}
 
 /* Scratch bytes the common part needs, and what each builder needs on top of it. */
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles);
@@ -89,6 +101,44 @@ int sp_meshlet_fits(const sp_meshlet_context* ctx, size_t t);
 void sp_meshlet_add(sp_meshlet_context* ctx, size_t t);
 /* Writes the open meshlet (if it has triangles) to the output and empties it. */
 void sp_meshlet_flush(sp_meshlet_context* ctx);
+/* Empties the open meshlet without writing it. */
+void sp_meshlet_reset_open(sp_meshlet_context* ctx);
+
+/* A split recorded as triangle lists before it is written (meshlets_merge.c): the skin builder
+ * closes its meshlets into a plan, merges underfull ones, then writes the plan. */
+typedef struct sp_meshlet_plan {
+    uint32_t* order;          /* triangles, meshlet by meshlet */
+    uint32_t* start;          /* meshlet m: order[start[m] .. start[m + 1]) */
+    uint32_t* next;           /* next meshlet merged into m's group, or UINT32_MAX */
+    uint32_t* tail;           /* last meshlet of m's group */
+    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order */
+    uint16_t* vertex_count;   /* as closed */
+    uint16_t* triangle_count; /* of m's group */
+    uint8_t* merged;          /* 1: m went into another meshlet's group */
+    uint64_t* keys;           /* scratch: sort keys */
+    size_t count;
+    /* after sp_meshlet_plan_link: each group's triangles as a list, named by the group's first meshlet */
+    uint32_t* owner;          /* per triangle: its group */
+    uint32_t* next_triangle;  /* per triangle: the next one of its group, or UINT32_MAX */
+    uint32_t* first_triangle; /* per group */
+} sp_meshlet_plan;
+
+size_t sp_meshlet_plan_scratch_bound(size_t triangle_count);
+void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count);
+/* Records the open meshlet (if it has triangles) as the plan's next one and empties it. */
+void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
+/* Merges underfull meshlets with near ones they fit with (rank: triangle -> Morton position). */
+void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* rank);
+/* meshlets_refine.c: turns the merged groups into triangle lists; then moves the few triangles
+ * that bring a joint into a meshlet to a neighbour where they cost fewer palette entries, never
+ * over a limit (vertex_adjacency_offset/vertex_adjacency: the triangles around each vertex, as
+ * the skin builder keeps them). */
+void sp_meshlet_plan_link(sp_meshlet_plan* plan);
+void sp_meshlet_plan_refine(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
+                            const uint32_t* vertex_adjacency);
+/* Writes every group of the linked plan as one meshlet. */
+void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
+
 /* Greedy in the given order (NULL: index order): close the meshlet when the next triangle does
  * not fit. Flushes at the end. This is the thesis's GenerateMeshlets. */
 void sp_meshlet_greedy(sp_meshlet_context* ctx, const uint32_t* order, size_t count);

@@ -1,17 +1,24 @@
 /*
- * meshlets_skin.c - our skin-aware builder.
+ * meshlets_skin.c - our skin-aware builder. Objective, in this order: as few meshlets as
+ * meshoptimizer (the count drives the cost of mesh-shader skinning), then few palette entries,
+ * then few local tuple bits; the palette limit max_joints is a hard cap, never exceeded.
  *
- * Grows one meshlet at a time like meshopt_buildMeshlets: the next triangle is the best live
- * triangle adjacent to the meshlet's vertices; when the meshlet's surface patch runs out, the
- * nearest free triangle (searched in a widening window of the Morton order of triangle
- * centroids, where meshoptimizer uses a k-d tree) continues it. The score adds skinning to
- * meshoptimizer's: a candidate costs its topological priority (0 if it adds no vertex, 1 if it
- * completes a vertex's fan, else new vertices + 1) plus joint_cost per joint it would add to the
- * palette and tuple_cost per tuple its new vertices would add to the local LUT, so a meshlet
- * fills up inside one region of the skeleton (and one band of a blend) before it crosses into
- * the next; ties go to the candidate nearest the meshlet's centroid, as in meshoptimizer. A meshlet
- * is closed when no adjacent triangle fits a limit, and the next one starts from the best of
- * those misfits, so consecutive meshlets stay neighbours and leave no scattered leftovers.
+ * Grows one meshlet at a time like meshopt_buildMeshlets (1.x): the next triangle is the best
+ * live triangle adjacent to the meshlet's vertices that fits every limit. A candidate costs its
+ * topological priority (topology_priority) plus joint_cost per joint it would add to the
+ * palette and tuple_cost per tuple its new vertices would add to the local LUT; both default to
+ * 0, because on the benchmark meshes even a joint tie-break (any joint_cost below one priority
+ * step) costs a few meshlets against the distance tie-break; the palette cap is enforced either
+ * way, and the refine step lowers the palette sum afterwards. Ties go to the
+ * candidate nearest the centre of the meshlet's triangles. When no adjacent triangle fits, the
+ * meshlet closes, leaves seed candidates on its border, and the next meshlet starts at the
+ * least enclosed seed (fewest free triangles around its corners, then nearest the mesh's low
+ * corner), so meshlets sweep across the surface and leave no slivers behind. When the surface
+ * patch runs out, the nearest free triangle (searched in a widening window of the Morton order
+ * of triangle centroids, where meshoptimizer uses a k-d tree) continues it. Meshlets are
+ * recorded as a plan and written at the end, after underfull ones are merged
+ * (meshlets_merge.c) and border triangles moved where they cost fewer palette entries
+ * (meshlets_refine.c).
  */
 #include "meshlets_internal.h"
 
@@ -23,6 +30,8 @@
 #define PROXIMITY_WINDOW 32       /* Morton neighbours searched on each side when a patch runs out, */
 #define PROXIMITY_WINDOW_MAX 2048 /* widened 8x at a time up to this */
 #define JUMP_JOINT_PENALTY 4.0f   /* distance factor per new joint (x joint_cost) for such jumps */
+#define SEEDS_PER_MESHLET 4       /* seed candidates a finished meshlet leaves on its border */
+#define SEED_POOL 256             /* seed candidates kept at most */
 
 typedef struct skin_state {
     uint32_t* adjacency_offset; /* vertex_count + 1: start of each vertex's triangle list */
@@ -38,28 +47,26 @@ typedef struct skin_state {
     uint32_t* tuple_stamp;      /* per tuple id: open_stamp while the open meshlet has the tuple */
     uint32_t open_stamp;        /* changes with every meshlet */
     uint32_t open_tuple_count;  /* distinct tuples of the open meshlet's vertices */
+    float corner[3];            /* low corner of the triangle centroids' box: seeds sweep away from it */
+    uint32_t seeds[SEED_POOL];  /* free triangles on the borders of finished meshlets */
+    uint32_t seed_count;
+    sp_meshlet_plan plan;       /* the meshlets closed so far, written at the end */
+    float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
 } skin_state;
-
-static size_t align8(size_t bytes)
-{
-    return (bytes + 7) & ~(size_t)7;
-}
 
 size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
 {
     size_t tuple_slots = sp_meshlet_tuple_set_slots(vertex_count);
-    return align8((vertex_count + 1) * sizeof(uint32_t)) + align8(triangle_count * 3 * sizeof(uint32_t)) +
-           align8(vertex_count * sizeof(uint32_t)) + align8(triangle_count) + align8(triangle_count * 3 * sizeof(float)) +
-           align8(triangle_count * sizeof(uint64_t)) + align8(triangle_count * sizeof(uint32_t)) +
-           align8(vertex_count * sizeof(uint32_t)) + align8((tuple_slots + 1) * sizeof(uint32_t)) +
-           align8(tuple_slots * sizeof(uint64_t));
-}
-
-static void* carve(unsigned char** cursor, size_t bytes)
-{
-    void* block = *cursor;
-    *cursor += align8(bytes);
-    return block;
+    size_t per_vertex = sp_meshlet_align8((vertex_count + 1) * sizeof(uint32_t)) + /* adjacency_offset */
+                        2 * sp_meshlet_align8(vertex_count * sizeof(uint32_t));     /* live, vertex_tuple */
+    size_t per_triangle = sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + /* adjacency */
+                          sp_meshlet_align8(triangle_count) +                        /* emitted */
+                          sp_meshlet_align8(triangle_count * 3 * sizeof(float)) +    /* centroid */
+                          sp_meshlet_align8(triangle_count * sizeof(uint64_t)) +     /* morton */
+                          sp_meshlet_align8(triangle_count * sizeof(uint32_t));      /* rank */
+    size_t tuples = sp_meshlet_align8((tuple_slots + 1) * sizeof(uint32_t)) + /* tuple_stamp */
+                    sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
+    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count);
 }
 
 /* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
@@ -127,6 +134,7 @@ static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
     for (int i = 0; i < 3; ++i)
         extent = hi[i] - lo[i] > extent ? hi[i] - lo[i] : extent;
     float scale = extent > 0.0f ? 1023.0f / extent : 0.0f;
+    memcpy(s->corner, lo, sizeof(lo));
     for (size_t t = 0; t < ctx->triangle_count; ++t) {
         const float* c = s->centroid + t * 3;
         uint32_t code = 0;
@@ -141,10 +149,10 @@ static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
         s->rank[(uint32_t)s->morton[i]] = (uint32_t)i;
 }
 
-static void open_centroid(const sp_meshlet_context* ctx, float* point)
+static void open_centroid(const sp_meshlet_context* ctx, const skin_state* s, float* point)
 {
     for (int i = 0; i < 3; ++i)
-        point[i] = ctx->open_position_sum[i] / (float)ctx->open_vertex_count;
+        point[i] = s->centroid_sum[i] / (float)ctx->open_triangle_count;
 }
 
 static float distance_to(const skin_state* s, uint32_t t, const float* point)
@@ -165,6 +173,8 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
         }
     }
     sp_meshlet_add(ctx, t);
+    for (int i = 0; i < 3; ++i)
+        s->centroid_sum[i] += s->centroid[(size_t)t * 3 + i];
     s->emitted[t] = 1;
     s->last_rank = s->rank[t];
     for (int c = 0; c < 3; ++c) {
@@ -181,10 +191,101 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
     }
 }
 
-/* Closes the open meshlet. */
+/* How enclosed free triangle t is: the free triangles around its corners (t counted at each).
+ * Low values are mesh corners and strips left between meshlets, which strand triangles unless
+ * a meshlet starts there. */
+static uint32_t enclosure(const sp_meshlet_context* ctx, const skin_state* s, uint32_t t)
+{
+    const uint32_t* tri = ctx->indices + (size_t)t * 3;
+    return s->live[tri[0]] + s->live[tri[1]] + s->live[tri[2]];
+}
+
+typedef struct seed {
+    uint32_t triangle, enclosure;
+    float corner_distance; /* squared: ties go to the seed nearest the corner, so meshlets sweep */
+} seed;
+
+static seed make_seed(const sp_meshlet_context* ctx, const skin_state* s, uint32_t t)
+{
+    seed result = {t, enclosure(ctx, s, t), distance_to(s, t, s->corner)};
+    return result;
+}
+
+static int better_seed(const seed* a, const seed* b)
+{
+    if (a->triangle == NO_TRIANGLE || b->triangle == NO_TRIANGLE)
+        return b->triangle == NO_TRIANGLE && a->triangle != NO_TRIANGLE;
+    if (a->enclosure != b->enclosure)
+        return a->enclosure < b->enclosure;
+    if (a->corner_distance != b->corner_distance)
+        return a->corner_distance < b->corner_distance;
+    return a->triangle < b->triangle;
+}
+
+/* Drops the seeds that meshlets have taken since they were added. */
+static void prune_seeds(skin_state* s)
+{
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < s->seed_count; ++i)
+        if (!s->emitted[s->seeds[i]])
+            s->seeds[kept++] = s->seeds[i];
+    s->seed_count = kept;
+}
+
+/* Before the open meshlet closes, each of its vertices nominates its least enclosed free
+ * triangle; the best SEEDS_PER_MESHLET nominees join the pool (when it has room). */
+static void add_border_seeds(const sp_meshlet_context* ctx, skin_state* s)
+{
+    seed best[SEEDS_PER_MESHLET];
+    for (int i = 0; i < SEEDS_PER_MESHLET; ++i) {
+        seed none = {NO_TRIANGLE, 0, 0.0f};
+        best[i] = none;
+    }
+    for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
+        uint32_t v = ctx->open_vertices[i];
+        const uint32_t* list = s->adjacency + s->adjacency_offset[v];
+        seed nominee = {NO_TRIANGLE, 0, 0.0f};
+        for (uint32_t j = 0; j < s->live[v]; ++j) {
+            seed c = make_seed(ctx, s, list[j]);
+            if (better_seed(&c, &nominee))
+                nominee = c;
+        }
+        if (nominee.triangle == NO_TRIANGLE)
+            continue;
+        int worst = 0, present = 0;
+        for (int k = 0; k < SEEDS_PER_MESHLET; ++k) {
+            present |= best[k].triangle == nominee.triangle;
+            if (better_seed(&best[worst], &best[k]))
+                worst = k;
+        }
+        if (!present && better_seed(&nominee, &best[worst]))
+            best[worst] = nominee;
+    }
+    prune_seeds(s);
+    for (int k = 0; k < SEEDS_PER_MESHLET && s->seed_count < SEED_POOL; ++k)
+        if (best[k].triangle != NO_TRIANGLE)
+            s->seeds[s->seed_count++] = best[k].triangle;
+}
+
+/* The least enclosed free seed of the pool, or NO_TRIANGLE. */
+static uint32_t pick_seed(const sp_meshlet_context* ctx, skin_state* s)
+{
+    prune_seeds(s);
+    seed best = {NO_TRIANGLE, 0, 0.0f};
+    for (uint32_t i = 0; i < s->seed_count; ++i) {
+        seed c = make_seed(ctx, s, s->seeds[i]);
+        if (better_seed(&c, &best))
+            best = c;
+    }
+    return best.triangle;
+}
+
+/* Closes the open meshlet, leaving seeds on its border for the next ones. */
 static void flush(sp_meshlet_context* ctx, skin_state* s)
 {
-    sp_meshlet_flush(ctx);
+    add_border_seeds(ctx, s);
+    sp_meshlet_plan_close(ctx, &s->plan);
+    s->centroid_sum[0] = s->centroid_sum[1] = s->centroid_sum[2] = 0.0f;
     s->open_stamp++;
     s->open_tuple_count = 0;
 }
@@ -226,13 +327,19 @@ static int better(const candidate* a, const candidate* b)
     return a->triangle < b->triangle;
 }
 
-/* meshoptimizer's topological priority: 0 when t adds no vertex, 1 when it completes a
- * vertex's fan (that vertex then leaves the meshlet border), else new vertices + 1. */
+/* Topological priority, lower first (after meshoptimizer 1.x): 0 when t adds no vertex; 1 when
+ * it completes a vertex's fan (that vertex then leaves the meshlet border, and a triangle left
+ * dangling would cost a later meshlet up to two vertices); new vertices + 1 when two of its
+ * corners have only one other free triangle (taking t leaves that one dangling, so the border
+ * stays short); else new vertices + 2. */
 static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_t new_vertices)
 {
     if (new_vertices == 0)
         return 0.0f;
-    return (s->live[tri[0]] == 1 || s->live[tri[1]] == 1 || s->live[tri[2]] == 1) ? 1.0f : new_vertices + 1.0f;
+    uint32_t a = s->live[tri[0]], b = s->live[tri[1]], c = s->live[tri[2]];
+    if (a == 1 || b == 1 || c == 1)
+        return 1.0f;
+    return (float)new_vertices + ((a == 2) + (b == 2) + (c == 2) >= 2 ? 1.0f : 2.0f);
 }
 
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
@@ -244,7 +351,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
     if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
         return best;
     float point[3];
-    open_centroid(ctx, point);
+    open_centroid(ctx, s, point);
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
         uint32_t v = ctx->open_vertices[i];
         const uint32_t* list = s->adjacency + s->adjacency_offset[v];
@@ -260,11 +367,15 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
-            float cost = priority + ctx->options.joint_cost * (float)new_joints +
-                         ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
+            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            if (ctx->options.tuple_cost > 0.0f)
+                cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             candidate c = {t, cost, distance_to(s, t, point)};
+            if (cost == 0.0f)
+                return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
+                           * such triangles join does not change the meshlet */
             if (better(&c, &best))
                 best = c;
         }
@@ -313,22 +424,26 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     unsigned char* cursor = ctx->builder_scratch;
     size_t t_count = ctx->triangle_count, v_count = ctx->vertex_count;
     skin_state s;
-    s.adjacency_offset = carve(&cursor, (v_count + 1) * sizeof(uint32_t));
-    s.adjacency = carve(&cursor, t_count * 3 * sizeof(uint32_t));
-    s.live = carve(&cursor, v_count * sizeof(uint32_t));
-    s.emitted = carve(&cursor, t_count);
-    s.centroid = carve(&cursor, t_count * 3 * sizeof(float));
-    s.morton = carve(&cursor, t_count * sizeof(uint64_t));
-    s.rank = carve(&cursor, t_count * sizeof(uint32_t));
+    s.adjacency_offset = sp_meshlet_carve(&cursor, (v_count + 1) * sizeof(uint32_t));
+    s.adjacency = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(uint32_t));
+    s.live = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
+    s.emitted = sp_meshlet_carve(&cursor, t_count);
+    s.centroid = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(float));
+    s.morton = sp_meshlet_carve(&cursor, t_count * sizeof(uint64_t));
+    s.rank = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
     s.seed_cursor = 0;
     s.last_rank = 0;
-    s.vertex_tuple = carve(&cursor, v_count * sizeof(uint32_t));
+    s.vertex_tuple = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
     size_t tuple_slots = sp_meshlet_tuple_set_slots(v_count);
-    s.tuple_stamp = carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
-    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, carve(&cursor, tuple_slots * sizeof(uint64_t)), s.vertex_tuple);
+    s.tuple_stamp = sp_meshlet_carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
+    uint64_t* tuple_set = sp_meshlet_carve(&cursor, tuple_slots * sizeof(uint64_t));
+    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, tuple_set, s.vertex_tuple);
     memset(s.tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
     s.open_stamp = 1;
     s.open_tuple_count = 0;
+    s.seed_count = 0;
+    s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
+    sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     build_spatial_order(ctx, &s);
@@ -345,15 +460,17 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         }
         candidate any = best_neighbour(ctx, &s, 0);
         if (any.triangle != NO_TRIANGLE) {
-            /* the patch goes on but the meshlet is full: the next meshlet continues from here */
+            /* the patch goes on but the meshlet is full: the next meshlet starts at the least
+             * enclosed border seed (so no sliver is stranded), else where this one stopped */
             flush(ctx, &s);
-            emit(ctx, &s, any.triangle);
+            uint32_t next = pick_seed(ctx, &s);
+            emit(ctx, &s, next != NO_TRIANGLE ? next : any.triangle);
             continue;
         }
         /* the surface patch is used up: jump to the nearest free triangle, into this meshlet if
          * it has room for one more disconnected triangle (3 new vertices), else into the next */
         float point[3];
-        open_centroid(ctx, point);
+        open_centroid(ctx, &s, point);
         uint32_t near = NO_TRIANGLE;
         if (ctx->open_vertex_count + 3 <= ctx->options.max_vertices &&
             ctx->open_triangle_count < ctx->options.max_triangles)
@@ -364,5 +481,9 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         }
         emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
     }
-    sp_meshlet_flush(ctx);
+    sp_meshlet_plan_close(ctx, &s.plan);
+    sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
+    sp_meshlet_plan_link(&s.plan);
+    sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
+    sp_meshlet_plan_write(ctx, &s.plan);
 }

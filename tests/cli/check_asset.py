@@ -189,8 +189,39 @@ def canonical(triangle):
     return tuple(triangle[i:] + triangle[:i])
 
 
+MESHLET_LIMITS = {"--meshlet-vertices": ("maxVertices", 64), "--meshlet-triangles": ("maxTriangles", 124),
+                  "--meshlet-joints": ("maxJoints", 32)}
+
+
+def requested_meshlet_limits(extra):
+    """The limits the file must record: the options given, else the documented defaults."""
+    limits = {field: default for field, default in MESHLET_LIMITS.values()}
+    for i, a in enumerate(extra[:-1]):
+        if a in MESHLET_LIMITS:
+            limits[MESHLET_LIMITS[a][0]] = int(extra[i + 1])
+    return limits
+
+
+def index_bits(count):
+    return (count - 1).bit_length()
+
+
+def check_meshlet_stats(stats, counts, where):
+    """compress --json's per-primitive meshlet statistics against the meshlets in the file."""
+    palette_entries = sum(c[2] for c in counts)
+    entries = sum(c[0] for c in counts)
+    local_bits = sum(c[0] * index_bits(c[3]) for c in counts) / entries
+    expected = {"count": len(counts), "max_joints": max(c[2] for c in counts), "palette_entries": palette_entries,
+                "mean_joints": palette_entries / len(counts), "local_tuple_bits_mean": local_bits}
+    for field, value in expected.items():
+        if abs(stats[field] - value) > 1e-6 * max(1.0, value):
+            raise SystemExit("%s: compress --json meshlets %s=%r, the file's meshlets give %r" %
+                             (where, field, stats[field], value))
+
+
 def check_meshlets(args, extra):
     base = outputs(args, extra)
+    limits = requested_meshlet_limits(extra)
     path = base + "_meshlets.glb"
     decoded_path = base + "_meshlets_decoded.glb"
     report = compress(args, "compact", path, extra + ["--meshlets"])
@@ -203,6 +234,9 @@ def check_meshlets(args, extra):
         ext = packed.json["meshes"][m]["primitives"][p]["extensions"][gltf_read.EXTENSION]
         ml = ext["meshlets"]
         k = ext["influences"]
+        if any(ml[field] != value for field, value in limits.items()):
+            raise SystemExit("mesh %d primitive %d: limits %r in the file, %r asked for" %
+                             (m, p, {f: ml[f] for f in limits}, limits))
         get = lambda name: packed.accessor(ml[name])  # noqa: E731
         offsets, counts, vertices, vtuples = get("offsets"), get("counts"), get("vertices"), get("vertexTuples")
         triangles, joints, tuples = get("triangles"), get("joints"), get("tuples")
@@ -229,11 +263,10 @@ def check_meshlets(args, extra):
                                          (index, v, s, joints[jo + tuple_entry[s]][0], djoints[v][s]))
         if sorted(seen) != source:
             raise SystemExit("mesh %d primitive %d: meshlet triangles differ from the source triangles" % (m, p))
-        stats = rows[(m, p)]["meshlets"]
-        if stats["count"] != len(offsets) or stats["max_joints"] != max(c[2] for c in counts):
-            raise SystemExit("mesh %d primitive %d: compress --json meshlets disagree with the file" % (m, p))
-        print("mesh %d prim %d: %d triangles in %d meshlets, palettes and local tuples match the decoded joints"
-              % (m, p, len(source), len(offsets)))
+        check_meshlet_stats(rows[(m, p)]["meshlets"], counts, "mesh %d primitive %d" % (m, p))
+        print("mesh %d prim %d: %d triangles in %d meshlets within %d/%d/%d, palettes and local tuples match the "
+              "decoded joints" % (m, p, len(source), len(offsets), limits["maxVertices"], limits["maxTriangles"],
+                                  limits["maxJoints"]))
 
 
 def main():
