@@ -30,9 +30,24 @@ typedef struct compressed_primitive {
     sp_compressed_skin skin;
     double input_bits_per_vertex;  /* JOINTS_n + WEIGHTS_n as stored in the input */
     double output_bits_per_vertex; /* vertex words + tuple table as stored in the output */
-    int placeholder_joints, placeholder_weights; /* compact mode: data-less JOINTS_0/WEIGHTS_0 */
     sp_meshlet_stats meshlet_stats; /* --meshlets */
 } compressed_primitive;
+
+/*
+ * Compact mode: the primitive keeps JOINTS_0/WEIGHTS_0, but their data moves to the fallback
+ * buffer (no bytes), as EXT_meshopt_compression does it: a loader without the extension fails
+ * to load the buffer instead of reading zeros, one with it fills them from the packed data.
+ * JOINTS_1/WEIGHTS_1 go (the packed skin has at most 4 influences). The freed bytes are cut.
+ */
+static void make_compact(gltf_doc* doc, const compressed_primitive* p) {
+    const gltf_skin_attributes* at = &p->attributes;
+    gltf_set_skin_attributes(doc, p->mesh, p->primitive, at->joints[0], at->weights[0]);
+    if (p->shared_with >= 0) return; /* the first primitive with these accessors moved them */
+    for (size_t s = 0; s < at->sets; ++s) {
+        gltf_make_fallback(doc, at->joints[s]);
+        gltf_make_fallback(doc, at->weights[s]);
+    }
+}
 
 static void compress_usage(FILE* out) {
     fprintf(out,
@@ -450,45 +465,36 @@ static void print_table(const compress_args* args, const compressed_primitive* p
            args->compact ? "" : " (JOINTS_0/WEIGHTS_0 are kept as well)", input_bytes, output_bytes);
 }
 
-int skinpack_cmd_compress(int argc, char** argv) {
-    compress_args args;
-    if (parse_args(argc, argv, &args)) return 2;
+/* Every skinned primitive, checked; primitives with the same accessors (and, with meshlets, the
+ * same geometry) point at the first with shared_with. Returns the count, or -1 after a message. */
+static long find_skinned(const gltf_doc* doc, const compress_args* args, compressed_primitive** out) {
     char err[CLI_ERR_SIZE];
-    gltf_doc* doc = gltf_load_file(args.input, err, sizeof(err));
-    if (!doc) {
-        fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
-        return 1;
-    }
     size_t capacity = 0, count = 0;
     compressed_primitive* prims = NULL;
-    int rc = 1;
     for (size_t m = 0; m < gltf_mesh_count(doc); ++m) {
         for (size_t pi = 0; pi < gltf_primitive_count(doc, m); ++pi) {
             gltf_packed_skin existing;
-            int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
-            if (has != 0) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi,
-                        has > 0 ? "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first" : err);
-                goto done;
-            }
             gltf_skin_attributes attributes;
-            int skinned = gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err));
+            int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
+            if (has > 0) snprintf(err, sizeof(err), "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first");
+            int skinned = has == 0 ? gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err)) : -1;
+            if (skinned > 0 && attributes.placeholder) {
+                snprintf(err, sizeof(err), "JOINTS_0/WEIGHTS_0 have no data and there is no " GLTF_EXTENSION_NAME);
+                skinned = -1;
+            }
             if (skinned < 0) {
-                fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
-                goto done;
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, m, pi, err);
+                free(prims);
+                return -1;
             }
             if (!skinned) continue;
-            if (attributes.placeholder) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: JOINTS_0/WEIGHTS_0 have no data and "
-                        "there is no " GLTF_EXTENSION_NAME "\n", args.input, m, pi);
-                goto done;
-            }
             if (count == capacity) {
                 capacity = capacity ? capacity * 2 : 16;
                 compressed_primitive* grown = realloc(prims, capacity * sizeof(*prims));
                 if (!grown) {
                     fprintf(stderr, "skinpack compress: out of memory\n");
-                    goto done;
+                    free(prims);
+                    return -1;
                 }
                 prims = grown;
             }
@@ -498,49 +504,70 @@ int skinpack_cmd_compress(int argc, char** argv) {
             p->primitive = pi;
             p->attributes = attributes;
             p->shared_with = -1;
-            for (size_t j = 0; j < count; ++j)
+            for (size_t j = 0; j < count && p->shared_with < 0; ++j)
                 if (prims[j].shared_with < 0 && same_attributes(&prims[j].attributes, &attributes) &&
-                    (!args.meshlets || gltf_same_geometry(doc, prims[j].mesh, prims[j].primitive, m, pi))) {
+                    (!args->meshlets || gltf_same_geometry(doc, prims[j].mesh, prims[j].primitive, m, pi)))
                     p->shared_with = (long)j;
-                    p->skin = prims[j].skin;
-                    p->packed = prims[j].packed;
-                    p->input_bits_per_vertex = prims[j].input_bits_per_vertex;
-                    p->output_bits_per_vertex = prims[j].output_bits_per_vertex;
-                    p->meshlet_stats = prims[j].meshlet_stats;
-                    break;
-                }
-            if (p->shared_with < 0 && compress_primitive(doc, &args, p, err, sizeof(err))) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi, err);
-                goto done;
-            }
             ++count;
         }
     }
-    /* Edit the primitives only after every one compressed: accessors are shared. Compact mode
-     * keeps JOINTS_0/WEIGHTS_0 on accessors without data, as KHR_draco_mesh_compression does:
-     * the skin still has a skinned mesh (the Khronos validator insists) and a decoder knows
-     * which attributes the extension supplies. */
+    *out = prims;
+    return (long)count;
+}
+
+/* Compresses each primitive once (the shared ones take the first's result). */
+static int compress_all(gltf_doc* doc, const compress_args* args, compressed_primitive* prims, size_t count) {
+    char err[CLI_ERR_SIZE];
     for (size_t i = 0; i < count; ++i) {
         compressed_primitive* p = &prims[i];
-        gltf_set_packed(doc, p->mesh, p->primitive, &p->packed);
-        if (!args.compact) continue;
-        if (p->shared_with < 0) {
-            p->placeholder_joints = gltf_add_accessor(doc, NULL, p->skin.vertex_count,
-                                                      p->skin.joint_bytes == 1 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT,
-                                                      4, 0, 0);
-            p->placeholder_weights = gltf_add_accessor(doc, NULL, p->skin.vertex_count, GLTF_FLOAT, 4, 0, 0);
-        } else {
-            p->placeholder_joints = prims[p->shared_with].placeholder_joints;
-            p->placeholder_weights = prims[p->shared_with].placeholder_weights;
+        if (p->shared_with >= 0) {
+            const compressed_primitive* first = &prims[p->shared_with];
+            p->skin = first->skin;
+            p->packed = first->packed;
+            p->input_bits_per_vertex = first->input_bits_per_vertex;
+            p->output_bits_per_vertex = first->output_bits_per_vertex;
+            p->meshlet_stats = first->meshlet_stats;
+        } else if (compress_primitive(doc, args, p, err, sizeof(err))) {
+            fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, p->mesh, p->primitive,
+                    err);
+            return -1;
         }
-        gltf_set_skin_attributes(doc, p->mesh, p->primitive, p->placeholder_joints, p->placeholder_weights);
+        gltf_set_packed(doc, p->mesh, p->primitive, &p->packed);
     }
-    if (count) gltf_declare_extension(doc, 1, args.compact);
-    if (count == 0) fprintf(stderr, "skinpack compress: %s: no skinned primitives; the file is copied\n", args.input);
-    if (args.compact && gltf_collect_garbage(doc, err, sizeof(err))) {
-        fprintf(stderr, "skinpack compress: %s: %s (use --fallback)\n", args.input, err);
+    return 0;
+}
+
+int skinpack_cmd_compress(int argc, char** argv) {
+    compress_args args;
+    if (parse_args(argc, argv, &args)) return 2;
+    char err[CLI_ERR_SIZE];
+    gltf_doc* doc = gltf_load_file(args.input, err, sizeof(err));
+    if (!doc) {
+        fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
+        return 1;
+    }
+    compressed_primitive* prims = NULL;
+    int rc = 1;
+    long found = find_skinned(doc, &args, &prims);
+    if (found < 0) goto done;
+    size_t count = (size_t)found;
+    if (count == 0) {
+        size_t copied = 0;
+        if (gltf_write_unchanged(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &copied,
+                                 err, sizeof(err))) {
+            fprintf(stderr, "skinpack compress: %s\n", err);
+            goto done;
+        }
+        fprintf(stderr, "skinpack compress: %s: no skinned primitives, nothing to compress; written unchanged to %s\n",
+                args.input, args.output);
+        rc = 0;
         goto done;
     }
+    /* Compact mode moves JOINTS_n/WEIGHTS_n out first, so that the packed arrays end the
+     * accessor and bufferView lists and decompress can take them away again without a trace. */
+    for (size_t i = 0; i < count && args.compact; ++i) make_compact(doc, &prims[i]);
+    if (compress_all(doc, &args, prims, count)) goto done;
+    gltf_declare_extension(doc, 1, args.compact);
     size_t output_bytes = 0;
     if (gltf_write_file(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &output_bytes, err,
                         sizeof(err))) {
