@@ -396,11 +396,12 @@ extern "C" void gltf_declare_extension(gltf_doc* doc, int used, int required) {
 // Removes accessors from the end of the array while nothing refers to them and `removable`
 // says they are skinpack's, then their bufferViews the same way (cutting their bytes).
 extern "C" size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, size_t removable_count) {
-    if (!references_known(doc)) return 0;
+    if (!references_known(doc) || !doc->json.contains("accessors")) return 0;
     std::vector<int> ours(removable, removable + removable_count);
     size_t freed = 0;
     ordered_json& accessors = gltf_json_array(doc, "accessors");
     std::vector<size_t> candidate_views;
+    bool removed_accessors = false, removed_views = false;
     while (!accessors.empty()) {
         int last = int(accessors.size() - 1);
         references refs = find_references(doc);
@@ -408,7 +409,7 @@ extern "C" size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, s
         if (const ordered_json* v = member(accessors.back(), "bufferView"))
             if (v->is_number_unsigned()) candidate_views.push_back(v->get<size_t>());
         accessors.erase(accessors.end() - 1);
-        doc->edited = true;
+        removed_accessors = doc->edited = true;
     }
     ordered_json& views = gltf_json_array(doc, "bufferViews");
     while (!views.empty()) {
@@ -420,16 +421,23 @@ extern "C" size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, s
         if (buffer && buffer->is_number_integer() && buffer->get<int>() == GLTF_PENDING_FALLBACK_BUFFER) break;
         freed += cut_view_bytes(doc, last);
         views.erase(views.end() - 1);
+        removed_views = true;
     }
-    if (accessors.empty()) doc->json.erase("accessors");
-    if (views.empty()) doc->json.erase("bufferViews");
+    if (removed_accessors && accessors.empty()) doc->json.erase("accessors");
+    if (removed_views && views.empty()) doc->json.erase("bufferViews");
     return freed;
+}
+
+// A data-less buffer of the input that skinpack's compact mode made (marked with our extension).
+static bool is_our_fallback(const gltf_doc* doc, size_t buffer) {
+    if (buffer >= doc->fallback_buffer.size() || !doc->fallback_buffer[buffer]) return false;
+    const ordered_json* extensions = member(doc->json["buffers"][buffer], "extensions");
+    return extensions && member(*extensions, GLTF_EXTENSION_NAME);
 }
 
 static bool in_input_fallback(const gltf_doc* doc, const ordered_json& view) {
     const ordered_json* buffer = member(view, "buffer");
-    return buffer && buffer->is_number_unsigned() && buffer->get<size_t>() < doc->fallback_buffer.size() &&
-           doc->fallback_buffer[buffer->get<size_t>()];
+    return buffer && buffer->is_number_unsigned() && is_our_fallback(doc, buffer->get<size_t>());
 }
 
 extern "C" void gltf_release_fallback(gltf_doc* doc) {
@@ -562,17 +570,19 @@ static void place_new_data(const gltf_doc* doc, ordered_json& json, bool binary,
 static void drop_unused_buffers(const gltf_doc* doc, ordered_json& json) {
     if (!json.contains("buffers") || !json["buffers"].is_array()) return;
     ordered_json& buffers = json["buffers"];
+    bool dropped = false;
     while (!buffers.empty()) {
         size_t last = buffers.size() - 1;
         auto cut = doc->cut_data.find(last);
         bool emptied = cut != doc->cut_data.end() && cut->second.empty();
-        if (!emptied && (last >= doc->fallback_buffer.size() || !doc->fallback_buffer[last])) return;
+        if (!emptied && !is_our_fallback(doc, last)) break;
         std::vector<std::pair<size_t, size_t>> used;
         used_ranges(doc, int(last), SIZE_MAX, &used);
-        if (!used.empty()) return;
+        if (!used.empty()) break;
         buffers.erase(buffers.end() - 1);
+        dropped = true;
     }
-    if (buffers.empty()) json.erase("buffers");
+    if (dropped && buffers.empty()) json.erase("buffers");
 }
 
 static std::string folder_of(const char* path) {

@@ -61,20 +61,11 @@ static int split_glb(const unsigned char* bytes, size_t size, std::string* json_
     return 0;
 }
 
-// A buffer that holds no data on purpose: EXT_meshopt_compression's (and our compact mode's)
-// fallback buffer, without uri and marked {"fallback": true}. In a GLB, buffer 0 without uri is
-// the BIN chunk instead.
-static bool is_fallback_buffer(const ordered_json& buffer) {
-    if (!buffer.is_object() || buffer.contains("uri")) return false;
-    auto extensions = buffer.find("extensions");
-    if (extensions == buffer.end() || !extensions->is_object()) return false;
-    for (const char* name : {GLTF_EXTENSION_NAME, "EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-        auto ext = extensions->find(name);
-        if (ext == extensions->end() || !ext->is_object()) continue;
-        auto flag = ext->find("fallback");
-        if (flag != ext->end() && flag->is_boolean() && flag->get<bool>()) return true;
-    }
-    return false;
+// A buffer without data: no uri (and not a GLB's buffer 0, the BIN chunk). EXT_meshopt_compression's
+// fallback buffer and our compact mode's (marked {"fallback": true}) are such buffers; reading an
+// accessor from one is refused.
+static bool is_dataless_buffer(const ordered_json& buffer) {
+    return buffer.is_object() && !buffer.contains("uri");
 }
 
 // The bytes tinygltf gets: the input, except that fallback buffers get a 4-byte data uri
@@ -120,7 +111,7 @@ static int parse_json(gltf_doc* doc, const unsigned char* bytes, size_t size, ch
     auto buffers = doc->json.find("buffers");
     if (buffers != doc->json.end() && buffers->is_array())
         for (size_t i = 0; i < buffers->size(); ++i)
-            doc->fallback_buffer.push_back(!(doc->binary && i == 0) && is_fallback_buffer((*buffers)[i]));
+            doc->fallback_buffer.push_back(!(doc->binary && i == 0) && is_dataless_buffer((*buffers)[i]));
     return 0;
 }
 
@@ -141,10 +132,19 @@ static int load_model(gltf_doc* doc, const std::string& input, char* err, size_t
         ok = false;
     }
     if (ok) return 0;
-    while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
-    // tinygltf says "File not found : " with an empty name for a missing uri.
-    if (error.rfind("File not found : ", 0) == 0 && error.size() == strlen("File not found : "))
-        error = "a buffer or image file it refers to does not exist";
+    // tinygltf's errors are lines, some of them "File not found : " without a name: one line.
+    std::string message;
+    size_t start = 0;
+    while (start < error.size()) {
+        size_t end = error.find('\n', start);
+        if (end == std::string::npos) end = error.size();
+        std::string line = error.substr(start, end - start);
+        while (!line.empty() && line.back() == ' ') line.pop_back();
+        if (line == "File not found :") line = "a file it refers to was not found";
+        if (!line.empty() && message.find(line) == std::string::npos) message += (message.empty() ? "" : "; ") + line;
+        start = end + 1;
+    }
+    error = message;
     return fail(err, err_size, "not a readable glTF file: %s", error.empty() ? "parse error" : error.c_str());
 }
 
