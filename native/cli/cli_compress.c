@@ -18,6 +18,7 @@ typedef struct compress_args {
     int compact;
     int json;
     int meshlets; /* --meshlets: also write skin-aware meshlets */
+    int weight_bits_given; /* --weight-bits (0 in options.weight_bits means "not given") */
 } compress_args;
 
 /* One primitive's outcome. Primitives with the same JOINTS_n/WEIGHTS_n accessors share the
@@ -73,6 +74,43 @@ static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
     return 0;
 }
 
+/* The weight-code widths the library accepts for a method and K (lo > hi: none). */
+static void weight_bits_range(sp_method method, uint32_t k, uint32_t* lo, uint32_t* hi) {
+    *lo = SP_MAX_WEIGHT_BITS + 1;
+    *hi = 0;
+    for (uint32_t b = 0; b <= SP_MAX_WEIGHT_BITS; ++b) {
+        sp_codec codec;
+        if (sp_codec_from_bits(method, k, b, &codec) != SP_OK) continue;
+        if (b < *lo) *lo = b;
+        *hi = b;
+    }
+}
+
+/* --weight-bits / --vertex-bits against what the method can do with --max-influences
+ * influences (a primitive with fewer influences is checked again when it is compressed). */
+static int check_budget(const compress_args* args) {
+    const sp_compress_options* o = &args->options;
+    uint32_t lo, hi;
+    weight_bits_range(o->method, o->max_influences, &lo, &hi);
+    const char* name = sp_method_name(o->method);
+    if (lo > hi) {
+        fprintf(stderr, "skinpack compress: --method %s is not defined for %u influences (--max-influences)\n", name,
+                o->max_influences);
+        return -1;
+    }
+    if (args->weight_bits_given && (o->weight_bits == 0 || o->weight_bits < lo || o->weight_bits > hi)) {
+        fprintf(stderr, "skinpack compress: --weight-bits %u: method %s with %u influences takes %u..%u bits\n",
+                o->weight_bits, name, o->max_influences, lo ? lo : 1, hi);
+        return -1;
+    }
+    if (o->vertex_bits && o->vertex_bits < lo) {
+        fprintf(stderr, "skinpack compress: --vertex-bits %u: method %s with %u influences needs at least %u bits for "
+                "the weights, plus the tuple index\n", o->vertex_bits, name, o->max_influences, lo);
+        return -1;
+    }
+    return 0;
+}
+
 static int parse_args(int argc, char** argv, compress_args* args) {
     memset(args, 0, sizeof(*args));
     sp_compress_options_default(&args->options);
@@ -86,7 +124,9 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         } else if (strcmp(a, "--method") == 0 && value) {
             args->options.method = sp_method_from_name(value);
             if (args->options.method == SP_METHOD_COUNT) {
-                fprintf(stderr, "skinpack compress: unknown method '%s'\n", value);
+                fprintf(stderr, "skinpack compress: --method: unknown method '%s' (", value);
+                for (int m = 0; m < SP_METHOD_COUNT; ++m) fprintf(stderr, "%s%s", m ? ", " : "", sp_method_name((sp_method)m));
+                fprintf(stderr, ")\n");
                 return -1;
             }
             ++i;
@@ -100,6 +140,7 @@ static int parse_args(int argc, char** argv, compress_args* args) {
             ++i;
         } else if (strcmp(a, "--weight-bits") == 0 && value) {
             args->options.vertex_bits = 0;
+            args->weight_bits_given = 1;
             if (parse_uint(value, SP_MAX_WEIGHT_BITS, &args->options.weight_bits)) {
                 fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
                 return -1;
@@ -147,6 +188,7 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         fprintf(stderr, "skinpack compress: give at most one of --vertex-bits, --weight-bits, --max-error\n");
         return -1;
     }
+    if (check_budget(args)) return -1;
     if (!args->input || !args->output) {
         compress_usage(stderr);
         return -1;
@@ -328,9 +370,17 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     sp_result r = sp_compress_skin(joints, weights, vc, stride, joint_count, &options, words, lut, NULL, NULL,
                                    &p->skin, scratch, scratch_size);
     if (r != SP_OK) {
+        uint32_t lo, hi, k = p->skin.influences ? p->skin.influences : options.max_influences;
+        weight_bits_range(options.method, k, &lo, &hi);
         if (r == SP_ERR_JOINT_OUT_OF_RANGE)
             snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
                      p->skin.prepare.error_joint, joint_count);
+        else if (r == SP_ERR_BITS_OUT_OF_RANGE || r == SP_ERR_INVALID_ARGUMENT)
+            snprintf(err, err_size, "the bit budget (%s %u) fits no %s configuration for %u influences (the weights "
+                     "take %u..%u bits; with the tuple index at most %d bits in all)",
+                     options.weight_bits ? "--weight-bits" : "--vertex-bits",
+                     options.weight_bits ? options.weight_bits : options.vertex_bits, sp_method_name(options.method), k,
+                     lo, hi, SP_MAX_VERTEX_BITS);
         else
             snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
         goto done;

@@ -251,6 +251,20 @@ def main():
     failures += ["missing-buffer: %s" % p for p in
                  expect_failure([args.skinpack, "compress", path, "-o", out], "missing.bin", out, args.work)]
 
+    # A folder instead of a file (it used to abort with an uncaught C++ exception).
+    for command in ("info", "compress", "decompress"):
+        cmd = [args.skinpack, command, args.work] + (["-o", out] if command != "info" else [])
+        failures += ["folder: %s" % p for p in expect_failure(cmd, "is a folder", out if command != "info" else None,
+                                                              args.work)]
+
+    # Option mistakes are reported as option errors, naming the option.
+    for option, value in (("--weight-bits", "99"), ("--vertex-bits", "0"), ("--max-influences", "9"),
+                          ("--method", "zip"), ("--max-error", "2")):
+        cmd = [args.skinpack, "compress", args.asset, "-o", out, option, value]
+        result = subprocess.run(cmd, capture_output=True, text=True)
+        if result.returncode != 2 or option not in result.stderr or os.path.exists(out):
+            failures.append("option %s %s: exit %d, %r" % (option, value, result.returncode, result.stderr.strip()))
+
     # An output folder that does not exist: error, and nothing half-written anywhere.
     bad_out = os.path.join(args.work, "no-such-dir", "out.glb")
     failures += ["unwritable: %s" % p for p in

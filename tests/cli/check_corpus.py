@@ -253,7 +253,8 @@ def validate(node, validator, paths, jobs):
 # ---- one file ----
 
 def output_name(work, corpus, path, tag):
-    relative = os.path.relpath(path, corpus)
+    relative = os.path.relpath(path, corpus) if not os.path.relpath(path, corpus).startswith("..") else \
+        "also_" + os.path.basename(path)
     stem, ext = os.path.splitext(relative)
     out = os.path.join(work, stem.replace(os.sep, "__") + "." + tag + ext)
     return out
@@ -292,6 +293,7 @@ def main():
     parser.add_argument("--validator", required=True)
     parser.add_argument("--work", required=True)
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--also", nargs="*", default=[], help="more files (skinned ones, see make_rich_gltf.py)")
     parser.add_argument("corpus")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
@@ -299,6 +301,7 @@ def main():
                    if p.endswith((".gltf", ".glb")) and os.path.isfile(p))
     if len(files) < 300:
         raise SystemExit("FAILED: only %d glTF files under %s" % (len(files), args.corpus))
+    files += [os.path.abspath(p) for p in args.also]
     failures, written = {}, []
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         for path, (problems, outputs) in zip(files, pool.map(lambda p: check_file(args, p), files)):
@@ -316,12 +319,16 @@ def main():
             for problem in json_problems(source, out, via):
                 failures.setdefault(source, []).append("%s: %s" % (os.path.basename(out), problem))
     for path in sorted(failures):
-        print("FAIL %s" % os.path.relpath(path, args.corpus))
+        print("FAIL %s" % path)
         for problem in failures[path]:
             print("    " + problem)
     compressed = sum(1 for w in written if w[2] is None)
-    print("%s: %d files, %d written by compress (plus decompress), %d failed" % (
-        args.mode, len(files), compressed, len(failures)))
+    packed = sum(1 for w in written if w[2] is None and EXT in json.dumps(read_document(w[1])[0]))
+    print("%s: %d files, %d written by compress (%d with the extension), then decompressed; %d failed" % (
+        args.mode, len(files), compressed, packed, len(failures)))
+    if args.mode != "info" and args.also and packed < len(args.also):
+        print("FAILED: a skinned file given with --also was not compressed")
+        sys.exit(1)
     sys.exit(1 if failures else 0)
 
 
