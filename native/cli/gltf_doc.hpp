@@ -66,6 +66,9 @@ int gltf_view_accessor(const gltf_doc* doc, int index, const char* what, gltf_el
                        size_t err_size);
 double gltf_read_component(const gltf_element_view& view, size_t element, size_t component);
 
+// Decodes every EXT_/KHR_meshopt_compression bufferView into tinygltf's model (gltf_meshopt.cpp).
+int gltf_decode_meshopt(gltf_doc* doc, char* err, size_t err_size);
+
 // The JSON array doc->json[key], created empty when missing.
 ordered_json& gltf_json_array(gltf_doc* doc, const char* key);
 

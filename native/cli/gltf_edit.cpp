@@ -175,7 +175,7 @@ static void used_ranges(const gltf_doc* doc, int b, size_t skip_view, std::vecto
         for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
             const ordered_json* meshopt = extensions ? member(*extensions, name) : nullptr;
             const ordered_json* source = meshopt ? member(*meshopt, "buffer") : nullptr;
-            if (source && source->is_number_integer() && source->get<int>() == b) {
+            if (i != skip_view && source && source->is_number_integer() && source->get<int>() == b) {
                 size_t offset = json_size(*meshopt, "byteOffset");
                 out->push_back({offset, offset + json_size(*meshopt, "byteLength")});
             }
@@ -191,14 +191,22 @@ static void shift_offset(ordered_json& object, size_t from, size_t by) {
 // Cuts the bytes of bufferView `view` out of its buffer when skinpack writes that buffer and no
 // other range overlaps them; later views (and meshopt ranges) move down. Whole 4-byte words
 // only, so every alignment is kept. Returns the bytes freed.
+// The range a view's bytes occupy: its own, or for a meshopt view the compressed range.
+static ordered_json* byte_range_of(ordered_json& view) {
+    ordered_json* extensions = view.contains("extensions") ? &view["extensions"] : nullptr;
+    for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"})
+        if (extensions && extensions->is_object() && extensions->contains(name)) return &(*extensions)[name];
+    return &view;
+}
+
 static size_t cut_view_bytes(gltf_doc* doc, size_t view_index) {
     ordered_json& views = doc->json["bufferViews"];
-    ordered_json& view = views[view_index];
-    const ordered_json* buffer = member(view, "buffer");
+    ordered_json& range = *byte_range_of(views[view_index]);
+    const ordered_json* buffer = member(range, "buffer");
     if (!buffer || !buffer->is_number_integer()) return 0;
     int b = buffer->get<int>();
     std::vector<unsigned char>* bytes = rewritable_bytes(doc, b);
-    size_t begin = json_size(view, "byteOffset"), length = json_size(view, "byteLength") & ~size_t(3);
+    size_t begin = json_size(range, "byteOffset"), length = json_size(range, "byteLength") & ~size_t(3);
     if (!bytes || begin % 4 || length == 0 || begin + length > bytes->size()) return 0;
     std::vector<std::pair<size_t, size_t>> used;
     used_ranges(doc, b, view_index, &used);
@@ -250,6 +258,10 @@ static void place_view(gltf_doc* doc, ordered_json& view, const void* data, size
     view.erase("byteStride");
     if (flags & GLTF_ACCESSOR_VERTEX_ATTRIBUTE) view["target"] = 34962; // ARRAY_BUFFER
     else view.erase("target");
+    if (view.contains("extensions") && view["extensions"].is_object()) { // its meshopt data went with the old bytes
+        for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) view["extensions"].erase(name);
+        if (view["extensions"].empty()) view.erase("extensions");
+    }
 }
 
 static void set_bounds(ordered_json& accessor, const void* data, size_t count, int component_type, int components) {

@@ -148,16 +148,12 @@ static int load_model(gltf_doc* doc, const std::string& input, char* err, size_t
     return fail(err, err_size, "not a readable glTF file: %s", error.empty() ? "parse error" : error.c_str());
 }
 
-// Geometry-compression extensions keep the real bytes elsewhere; reading the fallback buffers
-// would give garbage or nothing.
+// Draco keeps the real bytes elsewhere, in a form skinpack does not decode (meshopt it does).
 static int check_required_extensions(const gltf_doc* doc, char* err, size_t err_size) {
     for (const std::string& name : doc->model.extensionsRequired) {
         if (name == "KHR_draco_mesh_compression")
             return fail(err, err_size, "the file requires KHR_draco_mesh_compression (Draco), which skinpack cannot "
                         "decode: write it without Draco, e.g. with gltfpack or glTF-Transform without draco");
-        if (name == "EXT_meshopt_compression" || name == "KHR_meshopt_compression")
-            return fail(err, err_size, "the file requires %s, which skinpack cannot decode yet: run gltfpack "
-                        "without -c, then skinpack, then compress", name.c_str());
     }
     return 0;
 }
@@ -203,7 +199,7 @@ static gltf_doc* load(const unsigned char* bytes, size_t size, const std::string
     doc->fallback_buffer.resize(doc->model.buffers.size(), false);
     for (size_t i = 0; i < doc->fallback_buffer.size(); ++i)
         if (doc->fallback_buffer[i]) doc->model.buffers[i].data.clear();
-    if (check_buffer_views(doc, err, err_size)) {
+    if (gltf_decode_meshopt(doc, err, err_size) || check_buffer_views(doc, err, err_size)) {
         delete doc;
         return nullptr;
     }
