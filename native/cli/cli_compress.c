@@ -527,18 +527,15 @@ static long find_skinned(const gltf_doc* doc, const compress_args* args, compres
             gltf_skin_attributes attributes;
             int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
             if (has > 0)
-                snprintf(err, sizeof(err), "mesh %zu primitive %zu: already carries " GLTF_EXTENSION_NAME "; run skinpack "
-                         "decompress first", m, pi);
-            else if (has < 0)
-                snprintf(err + strlen(err), sizeof(err) - strlen(err), " (mesh %zu primitive %zu)", m, pi);
+                snprintf(err, sizeof(err), "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first");
             int skinned = has == 0 ? gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err)) : -1;
             if (skinned > 0 && attributes.placeholder) {
-                snprintf(err, sizeof(err), "mesh %zu primitive %zu: JOINTS_0/WEIGHTS_0 have no data (no bufferView, or "
-                         "a buffer without data) and there is no " GLTF_EXTENSION_NAME " to supply it", m, pi);
+                snprintf(err, sizeof(err), "JOINTS_0/WEIGHTS_0 have no data (no bufferView, or a buffer without data) "
+                         "and there is no " GLTF_EXTENSION_NAME " to supply it");
                 skinned = -1;
             }
             if (skinned < 0) {
-                fprintf(stderr, "skinpack compress: %s: %s\n", args->input, err);
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, m, pi, err);
                 free(prims);
                 return -1;
             }

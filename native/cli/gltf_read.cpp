@@ -149,12 +149,14 @@ static int load_model(gltf_doc* doc, const std::string& input, char* err, size_t
 }
 
 // Draco keeps the real bytes elsewhere, in a form skinpack does not decode (meshopt it does).
+// Checked on the JSON, before tinygltf, which would only say "invalid bufferView".
 static int check_required_extensions(const gltf_doc* doc, char* err, size_t err_size) {
-    for (const std::string& name : doc->model.extensionsRequired) {
+    auto required = doc->json.find("extensionsRequired");
+    if (required == doc->json.end() || !required->is_array()) return 0;
+    for (const ordered_json& name : *required)
         if (name == "KHR_draco_mesh_compression")
             return fail(err, err_size, "the file requires KHR_draco_mesh_compression (Draco), which skinpack cannot "
-                        "decode: write it without Draco, e.g. with gltfpack or glTF-Transform without draco");
-    }
+                        "decode: compress the skin first, or use meshopt (gltfpack -cc) instead of Draco");
     return 0;
 }
 
@@ -191,8 +193,8 @@ static gltf_doc* load(const unsigned char* bytes, size_t size, const std::string
     doc->binary = memcmp(bytes, "glTF", 4) == 0;
     doc->path = path;
     doc->dir = base_dir;
-    if (parse_json(doc, bytes, size, err, err_size) || load_model(doc, tinygltf_input(doc, bytes, size), err, err_size) ||
-        check_required_extensions(doc, err, err_size)) {
+    if (parse_json(doc, bytes, size, err, err_size) || check_required_extensions(doc, err, err_size) ||
+        load_model(doc, tinygltf_input(doc, bytes, size), err, err_size)) {
         delete doc;
         return nullptr;
     }
@@ -401,18 +403,17 @@ extern "C" int gltf_primitive_skin(const gltf_doc* doc, size_t mesh, size_t prim
         const std::string& name = attribute.first;
         if ((name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) && name != "JOINTS_0" &&
             name != "JOINTS_1" && name != "WEIGHTS_0" && name != "WEIGHTS_1")
-            return fail(err, err_size, "mesh %zu primitive %zu: %s is not supported (at most 8 influences, "
-                        "JOINTS_0/1 and WEIGHTS_0/1)", mesh, primitive, name.c_str());
+            return fail(err, err_size, "%s is not supported (at most 8 influences, "
+                        "JOINTS_0/1 and WEIGHTS_0/1)", name.c_str());
     }
     for (size_t s = 0; s < GLTF_MAX_SKIN_SETS; ++s) {
         bool j = attributes->joints[s] >= 0, w = attributes->weights[s] >= 0;
         if (j != w)
-            return fail(err, err_size, "mesh %zu primitive %zu: %s_%zu without %s_%zu", mesh, primitive,
+            return fail(err, err_size, "%s_%zu without %s_%zu",
                         j ? "JOINTS" : "WEIGHTS", s, j ? "WEIGHTS" : "JOINTS", s);
         if (j) {
             if (attributes->sets != s)
-                return fail(err, err_size, "mesh %zu primitive %zu: JOINTS_%zu without JOINTS_%zu", mesh, primitive,
-                            s, s - 1);
+                return fail(err, err_size, "JOINTS_%zu without JOINTS_%zu", s, s - 1);
             attributes->sets = s + 1;
         }
     }
@@ -424,14 +425,14 @@ extern "C" int gltf_primitive_skin(const gltf_doc* doc, size_t mesh, size_t prim
     for (size_t s = 0; s < attributes->sets; ++s)
         for (int index : {attributes->joints[s], attributes->weights[s]}) {
             if (index < 0 || size_t(index) >= model.accessors.size())
-                return fail(err, err_size, "mesh %zu primitive %zu: accessor %d does not exist", mesh, primitive, index);
+                return fail(err, err_size, "accessor %d does not exist", index);
             const tinygltf::Accessor& a = model.accessors[size_t(index)];
             dataless += (a.bufferView < 0 && !a.sparse.isSparse) || in_fallback_buffer(doc, a.bufferView);
         }
     if (dataless) {
         if (dataless != 2 * attributes->sets)
-            return fail(err, err_size, "mesh %zu primitive %zu: some JOINTS_n/WEIGHTS_n accessors have data and some "
-                        "not", mesh, primitive);
+            return fail(err, err_size, "some JOINTS_n/WEIGHTS_n accessors have data and some "
+                        "not");
         attributes->placeholder = 1;
         attributes->vertex_count = model.accessors[size_t(attributes->joints[0])].count;
         attributes->joint_count = mesh_joint_count(model, mesh);
@@ -442,12 +443,12 @@ extern "C" int gltf_primitive_skin(const gltf_doc* doc, size_t mesh, size_t prim
     for (size_t s = 0; s < attributes->sets; ++s) {
         char what[64];
         gltf_element_view jv, wv;
-        snprintf(what, sizeof(what), "mesh %zu primitive %zu JOINTS_%zu", mesh, primitive, s);
+        snprintf(what, sizeof(what), "JOINTS_%zu", s);
         if (gltf_view_accessor(doc, attributes->joints[s], what, &jv, err, err_size)) return -1;
         if (jv.components != 4 || model.accessors[size_t(attributes->joints[s])].type != TINYGLTF_TYPE_VEC4 ||
             (jv.component_type != GLTF_UNSIGNED_BYTE && jv.component_type != GLTF_UNSIGNED_SHORT) || jv.normalized)
             return fail(err, err_size, "%s must be VEC4 of unnormalised UNSIGNED_BYTE or UNSIGNED_SHORT", what);
-        snprintf(what, sizeof(what), "mesh %zu primitive %zu WEIGHTS_%zu", mesh, primitive, s);
+        snprintf(what, sizeof(what), "WEIGHTS_%zu", s);
         if (gltf_view_accessor(doc, attributes->weights[s], what, &wv, err, err_size)) return -1;
         bool float_ok = wv.component_type == GLTF_FLOAT && !wv.normalized;
         bool int_ok = (wv.component_type == GLTF_UNSIGNED_BYTE || wv.component_type == GLTF_UNSIGNED_SHORT) &&
@@ -456,8 +457,7 @@ extern "C" int gltf_primitive_skin(const gltf_doc* doc, size_t mesh, size_t prim
             !(float_ok || int_ok))
             return fail(err, err_size, "%s must be VEC4 of FLOAT or normalised UNSIGNED_BYTE/UNSIGNED_SHORT", what);
         if (jv.count != wv.count || (s > 0 && jv.count != attributes->vertex_count))
-            return fail(err, err_size, "mesh %zu primitive %zu: JOINTS_n and WEIGHTS_n counts differ", mesh,
-                        primitive);
+            return fail(err, err_size, "JOINTS_n and WEIGHTS_n counts differ");
         attributes->vertex_count = jv.count;
         bits += 32.0 * double(gltf_component_size(jv.component_type) + gltf_component_size(wv.component_type));
     }

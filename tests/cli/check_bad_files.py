@@ -75,13 +75,25 @@ def view_past_buffer(d, b):
     d["bufferViews"][acc["bufferView"]]["byteOffset"] = len(b) - 8
 
 
-def requires_meshopt(d, b):
+def requires_draco(d, b):
+    d.setdefault("extensionsUsed", []).append("KHR_draco_mesh_compression")
+    d.setdefault("extensionsRequired", []).append("KHR_draco_mesh_compression")
+
+
+def broken_meshopt(d, b):
+    """JOINTS_0's view claims meshopt-compressed bytes that are not (16 bytes of the file)."""
     d.setdefault("extensionsUsed", []).append("EXT_meshopt_compression")
     d.setdefault("extensionsRequired", []).append("EXT_meshopt_compression")
+    accessor = d["accessors"][skinned(d)["attributes"]["JOINTS_0"]]
+    view = d["bufferViews"][accessor["bufferView"]]
+    view.setdefault("extensions", {})["EXT_meshopt_compression"] = {
+        "buffer": 0, "byteOffset": 0, "byteLength": 16, "byteStride": 8, "count": accessor["count"],
+        "mode": "ATTRIBUTES"}
 
 
 STANDARD = [
-    ("requires-meshopt", "EXT_meshopt_compression", requires_meshopt),
+    ("requires-draco", "Draco", requires_draco),
+    ("broken-meshopt", "does not decode", broken_meshopt),
     ("nan-weight", "finite", weights_value(float("nan"))),
     ("negative-weight", "negative", weights_value(-0.25)),
     ("joints-without-weights", "without WEIGHTS_0", drop_weights),
