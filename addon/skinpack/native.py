@@ -83,6 +83,7 @@ class CompressOptions(ctypes.Structure):
         ("max_spacing", ctypes.c_double),
         ("merge_dont_care", ctypes.c_int),
         ("sum_tolerance", ctypes.c_float),
+        ("max_error", ctypes.c_double),  # mirrors skinpack.h (issue 11); issue 13 generates this file
     ]
 
 

@@ -47,6 +47,8 @@ static int split_glb(const unsigned char* bytes, size_t size, std::string* json_
     if (header[2] > size)
         return fail(err, err_size, "not a readable glTF file: GLB header says %u bytes but the file has %zu (truncated)", header[2], size);
     size_t length = header[2];
+    if (length < sizeof(header))
+        return fail(err, err_size, "not a readable glTF file: the GLB header's length %zu is shorter than the header", length);
     if (header[4] != GLB_CHUNK_JSON) return fail(err, err_size, "not a readable glTF file: the first GLB chunk is not JSON");
     if (header[3] > length - 20) return fail(err, err_size, "not a readable glTF file: the GLB JSON chunk runs past the end of the file");
     json_text->assign(reinterpret_cast<const char*>(bytes) + 20, header[3]);

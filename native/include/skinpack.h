@@ -13,7 +13,8 @@
  * sp_result_string() turns it into a message. "K" is the number of influences kept per vertex
  * (1..4); per-vertex arrays of influences are dense, K (or the input stride) entries a vertex.
  *
- * The exact bit layout the library writes is specified in docs/format.md.
+ * The format is specified in docs/extension/README.md (1.0; conformance vectors in
+ * docs/extension/conformance/) and explained in docs/format.md.
  */
 #ifndef SKINPACK_H
 #define SKINPACK_H
@@ -57,6 +58,13 @@ typedef enum sp_result {
     SP_ERR_TUPLE_OUT_OF_RANGE,  /* a tuple index >= the tuple table size */
     SP_ERR_CORRUPT_DATA,        /* stored data violates the format (e.g. non-zero padding bits) */
     SP_ERR_LIMIT_EXCEEDED,      /* a meshlet limit that cannot be met (e.g. one triangle needs more joints than the palette) */
+    /* format validation (sp_validate_packed); appended so earlier values keep their numbers */
+    SP_ERR_CODE_OUTSIDE_SIMPLEX, /* a weight code <= max_code that no encoder writes (unsorted, or w1 < 0) */
+    SP_ERR_DUPLICATE_JOINT,      /* a vertex decodes to the same joint twice with weight on both */
+    SP_ERR_VERTEX_COUNT_MISMATCH, /* the packed vertex count differs from the primitive's */
+    SP_ERR_PARAMETER_MISMATCH,   /* a declared parameter contradicts another one or the stored data */
+    SP_ERR_ABI_MISMATCH,         /* the caller was built against another header (sp_check_abi) */
+    SP_ERR_INDEX_OUT_OF_RANGE,   /* a stored index or offset points past the array it indexes */
     SP_RESULT_COUNT
 } sp_result;
 
@@ -243,9 +251,12 @@ typedef struct sp_compress_options {
     uint32_t max_influences;    /* K, 1..4; default 4 */
     uint32_t vertex_bits;       /* budget for tuple index + weight code (e.g. 32, 48, 64); 0 = unused */
     uint32_t weight_bits;       /* budget for the weight code alone; 0 = unused */
-    double max_spacing;         /* target sample spacing (Delta); 0 = unused. Exactly one of the three is set. */
+    double max_spacing;         /* target sample spacing (Delta); 0 = unused */
     int merge_dont_care;        /* share tuples that differ only in zero-weight slots (default 1) */
     float sum_tolerance;        /* see sp_prepare_influences; default 1e-3 */
+    double max_error;           /* fewest weight bits whose proven bound (sp_codec.max_error) is <= this, for
+                                   the K actually used (sp_codec_from_max_error); 0 = unused.
+                                   Exactly one of vertex_bits, weight_bits, max_spacing, max_error is set. */
 } sp_compress_options;
 
 /* Fills the defaults: OSS, K = 4, vertex_bits = 32, merge_dont_care = 1, sum_tolerance = 1e-3. */
@@ -292,6 +303,188 @@ SP_API sp_result sp_decompress_skin(const sp_codec* codec, const uint32_t* words
                                     uint32_t tuple_bits, const uint16_t* lut, size_t lut_size,
                                     size_t joint_count, uint16_t* out_joints, float* out_weights,
                                     size_t* error_vertex);
+
+/* ---- Format rules (begin) ---- */
+/* ------------------------------------------------------------------------------------------ */
+/* Format rules and validation of a stored SKINPACK_packed_skin primitive                      */
+/* (docs/extension/README.md is the normative text; this is its one implementation)            */
+/* ------------------------------------------------------------------------------------------ */
+
+/* SP_VERSION of the built library. A caller compares it with the SP_VERSION it was built with. */
+SP_API uint32_t sp_version(void);
+
+/* The public structs, for sp_struct_size / sp_check_abi. Appended to, never renumbered. */
+typedef enum sp_struct_id {
+    SP_STRUCT_CODEC = 0,
+    SP_STRUCT_PREPARE_STATS,
+    SP_STRUCT_ERROR_STATS,
+    SP_STRUCT_COMPRESS_OPTIONS,
+    SP_STRUCT_COMPRESSED_SKIN,
+    SP_STRUCT_MESHLET_OPTIONS,
+    SP_STRUCT_MESHLET,
+    SP_STRUCT_MESHLET_SIZES,
+    SP_STRUCT_MESHLET_BUFFERS,
+    SP_STRUCT_MESHLET_STATS,
+    SP_STRUCT_PACKED_PARAMS,
+    SP_STRUCT_PACKED_MESHLETS,
+    SP_STRUCT_PACKED_PRIMITIVE,
+    SP_STRUCT_VALIDATION,
+    SP_STRUCT_COUNT
+} sp_struct_id;
+
+/* sizeof the struct as the library was compiled; 0 for an unknown id. */
+SP_API size_t sp_struct_size(sp_struct_id id);
+
+/*
+ * Checks that a caller and the library agree: version == sp_version() and, for each of the
+ * first count ids, struct_sizes[id] == sp_struct_size(id) (count <= SP_STRUCT_COUNT).
+ * Returns SP_OK or SP_ERR_ABI_MISMATCH; *bad_id (may be NULL) receives the first struct that
+ * differs, or SP_STRUCT_COUNT when the version differs. C callers use SP_CHECK_ABI(&bad_id).
+ */
+SP_API sp_result sp_check_abi(uint32_t version, const size_t* struct_sizes, size_t count, uint32_t* bad_id);
+
+/* Bytes of one tupleTable component: 1 (UNSIGNED_BYTE) if joint_count <= 256, 2 (UNSIGNED_SHORT)
+ * if <= SP_MAX_JOINTS, 0 if joint_count is 0 or larger. Writers and readers both use this. */
+SP_API uint32_t sp_joint_bytes(size_t joint_count);
+
+/* The largest integer a glTF JSON number may hold exactly (2^53). Larger values of "n" and
+ * "axisSamples" are written as decimal strings (sp_parse_decimal). */
+#define SP_JSON_MAX_SAFE_INTEGER ((uint64_t)1 << 53)
+
+/* Parses a JSON string value that holds a large integer: 1..20 decimal digits, no sign, no
+ * leading zero, value > SP_JSON_MAX_SAFE_INTEGER and <= UINT64_MAX (smaller values must be JSON
+ * numbers). length: characters of text (no NUL needed). SP_ERR_INVALID_ARGUMENT otherwise. */
+SP_API sp_result sp_parse_decimal(const char* text, size_t length, uint64_t* value);
+
+/* The fewest weight bits (0..64) of this method and K whose proven bound codec->max_error is
+ * <= max_error (> 0); the one search the CLI and the add-on share. K = 1 needs 0 bits. */
+SP_API sp_result sp_codec_from_max_error(sp_method method, uint32_t influences, double max_error, sp_codec* codec);
+
+/* Which declared property or stored array a validation failure is about. */
+typedef enum sp_field {
+    SP_FIELD_NONE = 0,
+    SP_FIELD_METHOD,
+    SP_FIELD_INFLUENCES,
+    SP_FIELD_JOINT_COUNT,
+    SP_FIELD_WEIGHT_BITS,
+    SP_FIELD_TUPLE_BITS,
+    SP_FIELD_N,
+    SP_FIELD_AXIS_SAMPLES,
+    SP_FIELD_MAX_ERROR,
+    SP_FIELD_VERTICES,          /* the "vertices" accessor (packed words) */
+    SP_FIELD_TUPLE_TABLE,       /* the "tupleTable" accessor */
+    SP_FIELD_MESHLET_OFFSETS,
+    SP_FIELD_MESHLET_COUNTS,
+    SP_FIELD_MESHLET_VERTICES,
+    SP_FIELD_MESHLET_VERTEX_TUPLES,
+    SP_FIELD_MESHLET_TRIANGLES,
+    SP_FIELD_MESHLET_JOINTS,
+    SP_FIELD_MESHLET_TUPLES,
+    SP_FIELD_MESHLET_LIMITS,    /* maxVertices / maxTriangles / maxJoints */
+    SP_FIELD_COUNT
+} sp_field;
+
+/* The extension property name of a field ("weightBits", "meshlets.counts"); "" for NONE. */
+SP_API const char* sp_field_name(sp_field field);
+
+/* The declared parameters of one primitive, as read from JSON. Integers are 64-bit so that a
+ * reader can pass what the file says without truncating it. */
+typedef struct sp_packed_params {
+    uint32_t method;            /* sp_method (sp_method_from_name of "method"); SP_METHOD_COUNT if unknown */
+    uint64_t influences;        /* K */
+    uint64_t joint_count;       /* "jointCount" */
+    uint64_t weight_bits;
+    uint64_t tuple_bits;
+    uint64_t n;
+    uint64_t axis_samples[SP_MAX_INFLUENCES - 1];
+    uint32_t axis_sample_count; /* entries of "axisSamples" (0 when absent; K - 1 for Any, else 0) */
+    uint32_t has_max_error;
+    double max_error;           /* "maxError" when has_max_error */
+} sp_packed_params;
+
+/* 1 if two primitives declare the same parameters (every field; axis_samples only up to
+ * axis_sample_count), else 0. Primitives that share a "vertices" accessor must (docs/extension). */
+SP_API int sp_packed_params_equal(const sp_packed_params* a, const sp_packed_params* b);
+
+/* The optional meshlet arrays (docs/extension: "meshlets"), each widened to the type here. */
+typedef struct sp_packed_meshlets {
+    size_t meshlet_count;
+    const uint32_t* offsets;       /* 4 a meshlet: vertex, triangle, joint, tuple offset */
+    const uint32_t* counts;        /* 4 a meshlet (UNSIGNED_SHORT in the file): vertex, triangle, joint, tuple count */
+    size_t vertex_entries;
+    const uint32_t* vertices;      /* vertex_entries source vertex indices */
+    const uint8_t* vertex_tuples;  /* vertex_entries local tuple indices */
+    size_t triangle_bytes;         /* bytes of triangles[], 3 a triangle */
+    const uint8_t* triangles;
+    size_t joint_entries;
+    const uint16_t* joints;        /* palettes */
+    size_t tuple_count;
+    const uint8_t* tuples;         /* tuple_count * K palette indices */
+    uint32_t max_vertices, max_triangles, max_joints; /* declared limits; 0 when absent */
+} sp_packed_meshlets;
+
+/* Everything a reader has of one packed primitive. */
+typedef struct sp_packed_primitive {
+    sp_packed_params params;
+    const uint32_t* words;           /* vertex_count * words_per_vertex little-endian words */
+    size_t vertex_count;             /* elements of the "vertices" accessor */
+    uint32_t words_per_vertex;       /* components of the "vertices" accessor (1 or 2) */
+    size_t primitive_vertex_count;   /* vertices of the primitive (POSITION count) */
+    const uint16_t* lut;             /* lut_size * lut_components joints (widened to u16) */
+    size_t lut_size;                 /* elements of the "tupleTable" accessor */
+    uint32_t lut_components;         /* its component count (must be K) */
+    uint32_t lut_component_bytes;    /* 1 for UNSIGNED_BYTE, 2 for UNSIGNED_SHORT (must be sp_joint_bytes) */
+    size_t skin_joint_count;         /* joints of the smallest skin of the nodes that use the mesh; 0 = none */
+    const sp_packed_meshlets* meshlets; /* NULL when the primitive has none */
+} sp_packed_primitive;
+
+/* Where validation stopped. index is the vertex (VERTICES), table entry (TUPLE_TABLE), meshlet
+ * (MESHLET_*) or axis (AXIS_SAMPLES); value and limit are the offending value and the bound or
+ * expected value it broke (e.g. code and max_code, count and expected count). */
+typedef struct sp_validation {
+    sp_result result;
+    uint32_t field;            /* sp_field */
+    size_t index;
+    uint64_t value;
+    uint64_t limit;
+    uint32_t slot, other_slot; /* SP_ERR_DUPLICATE_JOINT: the two weight slots */
+    sp_codec codec;            /* on SP_OK: the codec the parameters describe */
+} sp_validation;
+
+/*
+ * Validates one stored primitive completely and, if out_joints/out_weights are not NULL, decodes
+ * it (vertex_count * K each, weight order, as sp_decompress_skin). Checks, in order: every
+ * declared parameter's range and the method's rules for n/axisSamples (K = 1: n = 0, no
+ * axisSamples, weightBits 0); weightBits against the codec; tupleBits against the table size;
+ * words a vertex and the table's component type and count; jointCount against the skin and the
+ * vertex count against the primitive; then every table joint < jointCount, and every vertex:
+ * zero padding bits, tuple index < table size, code <= max_code, code inside the simplex, no
+ * joint twice with weight on both; then the meshlets (offsets + counts inside the arrays, no
+ * empty meshlet, declared limits, every index in range, and each meshlet vertex's palette joints
+ * equal to its decoded joints wherever its weight is non-zero).
+ * Returns the result also stored in report->result (report may be NULL). On failure outputs are
+ * partially written and must be discarded.
+ */
+SP_API sp_result sp_validate_packed(const sp_packed_primitive* primitive, uint16_t* out_joints, float* out_weights,
+                                    sp_validation* report);
+
+/*
+ * Writes a one-line message for a validation report into buffer (buffer_size bytes, always
+ * NUL-terminated when buffer_size > 0), e.g. "vertices: weight code outside the simplex at
+ * vertex 812". Returns the length the full message needs (as snprintf).
+ */
+SP_API size_t sp_format_validation(const sp_validation* report, char* buffer, size_t buffer_size);
+
+/* The sizes a C caller was compiled with, for sp_check_abi. */
+#define SP_STRUCT_SIZES_INIT                                                                           \
+    {sizeof(sp_codec), sizeof(sp_prepare_stats), sizeof(sp_error_stats), sizeof(sp_compress_options),  \
+     sizeof(sp_compressed_skin), sizeof(sp_meshlet_options), sizeof(sp_meshlet), sizeof(sp_meshlet_sizes), \
+     sizeof(sp_meshlet_buffers), sizeof(sp_meshlet_stats), sizeof(sp_packed_params),                    \
+     sizeof(sp_packed_meshlets), sizeof(sp_packed_primitive), sizeof(sp_validation)}
+/* C only (a compound literal): sp_check_abi with the caller's own version and sizes. */
+#define SP_CHECK_ABI(bad_id) \
+    sp_check_abi(SP_VERSION, (const size_t[SP_STRUCT_COUNT])SP_STRUCT_SIZES_INIT, SP_STRUCT_COUNT, (bad_id))
+/* ---- Format rules (end) ---- */
 
 /* ---- Meshlets (begin) ---- */
 /* ------------------------------------------------------------------------------------------ */

@@ -199,6 +199,22 @@ sp_result sp_codec_from_spacing(sp_method method, uint32_t influences, double ma
     return r;
 }
 
+sp_result sp_codec_from_max_error(sp_method method, uint32_t influences, double max_error, sp_codec* codec)
+{
+    sp_result r = start(method, influences, codec);
+    if (r != SP_OK) return r;
+    if (!(max_error > 0) || !isfinite(max_error)) return SP_ERR_BITS_OUT_OF_RANGE;
+    /* the bound falls as bits grow, but not strictly (Any/POT steps), so scan rather than bisect */
+    for (uint32_t bits = 0; bits <= SP_MAX_WEIGHT_BITS; ++bits) {
+        sp_codec candidate;
+        if (sp_codec_from_bits(method, influences, bits, &candidate) == SP_OK && candidate.max_error <= max_error) {
+            *codec = candidate;
+            return SP_OK;
+        }
+    }
+    return SP_ERR_BITS_OUT_OF_RANGE;
+}
+
 sp_result sp_codec_from_params(sp_method method, uint32_t influences, uint64_t n, const uint64_t* axis_samples,
                                sp_codec* codec)
 {
@@ -327,9 +343,10 @@ static int decode_valid(const sp_codec* codec, uint64_t code, float* weights)
     uint32_t k = codec->influences;
     float decoded[SP_MAX_INFLUENCES];
     if (code > codec->max_code) return 0;
-    if (k == 1 || codec->method == SP_METHOD_ANY) {
-        sp_decode_weights(codec, code, decoded);
-        if (decoded[0] < -1e-6f) return 0; /* Any: the stored weights sum past 1 */
+    if (k == 1) {
+        decoded[0] = 1.0f;
+    } else if (codec->method == SP_METHOD_ANY) {
+        if (sp_any_decode(codec, code, decoded) < 0) return 0; /* the stored weights sum past 1 */
     } else {
         uint64_t q[SP_MAX_INFLUENCES] = {0};
         if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);

@@ -94,7 +94,8 @@ int sp_oss_has_avx512(void);
 
 /* Any AABB works on floats directly (its axes do not share a grid). */
 uint64_t sp_any_encode(const sp_codec* codec, const float* weights);
-void sp_any_decode(const sp_codec* codec, uint64_t code, float* weights);
+/* Returns w1 in double before rounding: the code is valid iff it is >= 0. */
+double sp_any_decode(const sp_codec* codec, uint64_t code, float* weights);
 
 /* Finish a codec description (code_bits, bits, bounds) once method-specific fields are set. */
 sp_result sp_any_configure(uint32_t influences, const uint64_t* axis_samples, sp_codec* codec);

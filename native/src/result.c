@@ -16,10 +16,16 @@ const char* sp_result_string(sp_result result)
     case SP_ERR_TOO_MANY_JOINTS: return "more than 65535 joints";
     case SP_ERR_UNSUPPORTED_METHOD: return "unsupported method or influence count";
     case SP_ERR_BITS_OUT_OF_RANGE: return "bit budget or spacing out of range";
-    case SP_ERR_CODE_OUT_OF_RANGE: return "weight code is not below the codec's code count";
+    case SP_ERR_CODE_OUT_OF_RANGE: return "weight code above the largest code of the codec";
     case SP_ERR_TUPLE_OUT_OF_RANGE: return "tuple index is not below the tuple table size";
     case SP_ERR_CORRUPT_DATA: return "corrupt data";
     case SP_ERR_LIMIT_EXCEEDED: return "a limit cannot be met";
+    case SP_ERR_CODE_OUTSIDE_SIMPLEX: return "weight code outside the simplex";
+    case SP_ERR_DUPLICATE_JOINT: return "the same joint carries weight in two slots";
+    case SP_ERR_VERTEX_COUNT_MISMATCH: return "packed vertex count differs from the primitive's";
+    case SP_ERR_PARAMETER_MISMATCH: return "a parameter contradicts another one or the stored data";
+    case SP_ERR_ABI_MISMATCH: return "library and caller were built from different skinpack.h";
+    case SP_ERR_INDEX_OUT_OF_RANGE: return "an index or offset points past its array";
     default: return "unknown result code";
     }
 }

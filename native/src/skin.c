@@ -127,8 +127,9 @@ sp_result sp_compress_skin(const uint16_t* joints, const float* weights, size_t 
 {
     if (!options || !result || !words || !lut || vertex_count == 0) return SP_ERR_INVALID_ARGUMENT;
     memset(result, 0, sizeof(*result));
-    int budgets = (options->vertex_bits != 0) + (options->weight_bits != 0) + (options->max_spacing > 0);
-    if (budgets != 1) return SP_ERR_INVALID_ARGUMENT;
+    int budgets = (options->vertex_bits != 0) + (options->weight_bits != 0) + (options->max_spacing > 0) +
+                  (options->max_error > 0);
+    if (budgets != 1 || !(options->max_error >= 0) || !(options->max_spacing >= 0)) return SP_ERR_INVALID_ARGUMENT;
     if (options->max_influences < 1 || options->max_influences > SP_MAX_INFLUENCES) return SP_ERR_INVALID_ARGUMENT;
     scratch_layout l = layout_scratch(vertex_count);
     if (!scratch || scratch_size < l.total) return SP_ERR_BUFFER_TOO_SMALL;
@@ -153,8 +154,9 @@ sp_result sp_compress_skin(const uint16_t* joints, const float* weights, size_t 
     if (options->vertex_bits) {
         r = fit_vertex_budget(&w, options, &codec, &lut_size);
     } else {
-        r = options->weight_bits ? sp_codec_from_bits(options->method, k, options->weight_bits, &codec)
-                                 : sp_codec_from_spacing(options->method, k, options->max_spacing, &codec);
+        if (options->weight_bits) r = sp_codec_from_bits(options->method, k, options->weight_bits, &codec);
+        else if (options->max_error > 0) r = sp_codec_from_max_error(options->method, k, options->max_error, &codec);
+        else r = sp_codec_from_spacing(options->method, k, options->max_spacing, &codec);
         if (r == SP_OK) r = quantise_and_index(&w, &codec, &lut_size);
     }
     if (r != SP_OK) return r;

@@ -36,7 +36,7 @@ int main(void) {
     FIELD(sp_compress_options, method); FIELD(sp_compress_options, max_influences);
     FIELD(sp_compress_options, vertex_bits); FIELD(sp_compress_options, weight_bits);
     FIELD(sp_compress_options, max_spacing); FIELD(sp_compress_options, merge_dont_care);
-    FIELD(sp_compress_options, sum_tolerance);
+    FIELD(sp_compress_options, sum_tolerance); FIELD(sp_compress_options, max_error);
     END();
     BEGIN(sp_compressed_skin);
     FIELD(sp_compressed_skin, codec); FIELD(sp_compressed_skin, influences); FIELD(sp_compressed_skin, tuple_bits);

@@ -7,6 +7,7 @@
 
 #include <stddef.h>
 
+#include "sp_gpu.h"
 #include "vk_context.h"
 
 #define MAX_REPORTED_FAILURES 10
@@ -22,6 +23,16 @@ typedef struct harness {
 
 /* Counts a mismatch; prints the first MAX_REPORTED_FAILURES. */
 void fail_check(harness* h, const char* format, ...) __attribute__((format(printf, 2, 3)));
+
+/* Runs decode.comp over item_count items (shader_harness.c); returns malloc'ed records. */
+SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t mode, const uint32_t* words,
+                            size_t word_count, size_t item_count, const void* lut, size_t lut_bytes, int force_wide);
+/* A record's integer q_slot (x for Any) and its float weights. */
+uint64_t record_q(const SpDecodedRecord* r, int slot);
+const float* record_weights(const SpDecodedRecord* r);
+
+/* conformance FILE (harness_conformance.c): every valid vector of the spec's weights.jsonl. */
+void test_conformance(harness* h, const char* path);
 
 /* meshshader FILE (harness_meshshader.c): skin.mesh's body through skin_meshlet_test.comp. */
 void test_meshshader(harness* h, const char* path);

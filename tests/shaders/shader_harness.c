@@ -9,6 +9,7 @@
  *   skinpack_shader_harness meshlets FILE   skin.mesh's palette / local LUT / triangle fetch
  *   skinpack_shader_harness meshshader FILE skin.mesh's body (skin_meshlet.glsl) run as compute:
  *                                           skinning, triangle and normal-cone culling vs C
+ *   skinpack_shader_harness conformance FILE  the spec's conformance vectors (weights.jsonl)
  *
  * Per decoded code the checks are: (1) the GPU's integers re-encode to the input code with the
  * format.md formulas (exact at every width); (2) they lie on the grid (sum q_i = s, descending;
@@ -53,7 +54,7 @@ void fail_check(harness* h, const char* format, ...)
 
 /* Runs decode.comp over item_count items. words: 2 per item (codes mode) or words_per_vertex per
  * vertex; lut: the tuple LUT bytes (may be NULL). Returns malloc'ed records. */
-static SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t mode, const uint32_t* words,
+SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t mode, const uint32_t* words,
                                    size_t word_count, size_t item_count, const void* lut, size_t lut_bytes, int force_wide)
 {
     vkx_context* ctx = &h->ctx;
@@ -86,14 +87,14 @@ static SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t
 
 /* ---- C side: the format.md encoding formulas, applied to the GPU's integers ------------------- */
 
-static uint64_t record_q(const SpDecodedRecord* r, int slot)
+uint64_t record_q(const SpDecodedRecord* r, int slot)
 {
     const uint32_t* low = &r->q_low.x;
     const uint32_t* high = &r->q_high.x;
     return (uint64_t)low[slot] | (uint64_t)high[slot] << 32;
 }
 
-static const float* record_weights(const SpDecodedRecord* r) { return &r->weights.x; }
+const float* record_weights(const SpDecodedRecord* r) { return &r->weights.x; }
 
 /* Rebuilds the code from q (x for Any) as format.md section 2 writes it. */
 static u128 reencode(const sp_codec* codec, const uint64_t* q)
@@ -796,9 +797,9 @@ static void test_mesh(harness* h, const char* path)
 int main(int argc, char** argv)
 {
     int needs_file = argc >= 2 && (strcmp(argv[1], "mesh") == 0 || strcmp(argv[1], "meshlets") == 0 ||
-                                   strcmp(argv[1], "meshshader") == 0);
+                                   strcmp(argv[1], "meshshader") == 0 || strcmp(argv[1], "conformance") == 0);
     if (argc < 2 || (needs_file && argc < 3)) {
-        fprintf(stderr, "usage: %s codes|widths|vertices|mesh FILE|meshlets FILE|meshshader FILE\n", argv[0]);
+        fprintf(stderr, "usage: %s codes|widths|vertices|mesh FILE|meshlets FILE|meshshader FILE|conformance FILE\n", argv[0]);
         return 2;
     }
     harness h;
@@ -817,6 +818,7 @@ int main(int argc, char** argv)
     else if (strcmp(argv[1], "mesh") == 0) test_mesh(&h, argv[2]);
     else if (strcmp(argv[1], "meshlets") == 0) test_meshlets(&h, argv[2]);
     else if (strcmp(argv[1], "meshshader") == 0) test_meshshader(&h, argv[2]);
+    else if (strcmp(argv[1], "conformance") == 0) test_conformance(&h, argv[2]);
     else {
         fprintf(stderr, "unknown test %s\n", argv[1]);
         return 2;
