@@ -394,6 +394,7 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     p->packed.method = s->codec.method;
     p->packed.n = s->codec.n;
     for (uint32_t i = 0; i + 1 < k && i < 3; ++i) p->packed.axis_samples[i] = s->codec.axis_samples[i];
+    p->packed.axis_sample_count = s->codec.method == SP_METHOD_ANY && k > 1 ? k - 1 : 0; /* as it is written */
     p->packed.weight_bits = s->weight_bits;
     p->packed.tuple_bits = s->tuple_bits;
     p->packed.max_error = s->codec.max_error;

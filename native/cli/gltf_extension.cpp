@@ -24,6 +24,31 @@ static int json_integer(const tinygltf::Value& object, const char* key, double l
     return 0;
 }
 
+// n and axisSamples entries reach 2^63: a JSON integer up to 2^53, a string of decimal digits
+// above (docs/extension: "Large integers").
+static int json_large_integer(const tinygltf::Value& value, uint64_t* out) {
+    const double max_safe = 9007199254740992.0; // 2^53
+    if (value.IsNumber()) {
+        double d = value.GetNumberAsDouble();
+        if (!std::isfinite(d) || d != std::floor(d) || d < 0 || d > max_safe) return -1;
+        *out = uint64_t(d);
+        return 0;
+    }
+    if (!value.IsString()) return -1;
+    const std::string& text = value.Get<std::string>();
+    if (text.empty() || text.size() > 20 || text[0] == '0') return -1;
+    uint64_t v = 0;
+    for (char c : text) {
+        if (c < '0' || c > '9') return -1;
+        uint64_t digit = uint64_t(c - '0');
+        if (v > (UINT64_MAX - digit) / 10) return -1;
+        v = v * 10 + digit;
+    }
+    if (v <= uint64_t(max_safe)) return -1;
+    *out = v;
+    return 0;
+}
+
 extern "C" int gltf_get_packed(const gltf_doc* doc, size_t mesh, size_t primitive, gltf_packed_skin* packed,
                                char* err, size_t err_size) {
     const tinygltf::Primitive& prim = doc->model.meshes[mesh].primitives[primitive];
@@ -32,7 +57,6 @@ extern "C" int gltf_get_packed(const gltf_doc* doc, size_t mesh, size_t primitiv
     const tinygltf::Value& ext = it->second;
     memset(packed, 0, sizeof(*packed));
     if (!ext.IsObject()) return fail(err, err_size, GLTF_EXTENSION_NAME " must be a JSON object");
-    const double max_safe = 9007199254740992.0; // 2^53
     uint64_t v = 0;
     if (json_integer(ext, "vertices", 0, 2147483647.0, true, &v, err, err_size)) return -1;
     packed->vertices = int(v);
@@ -46,7 +70,10 @@ extern "C" int gltf_get_packed(const gltf_doc* doc, size_t mesh, size_t primitiv
     packed->weight_bits = uint32_t(v);
     if (json_integer(ext, "tupleBits", 0, 32, true, &v, err, err_size)) return -1;
     packed->tuple_bits = uint32_t(v);
-    if (json_integer(ext, "n", 0, max_safe, true, &packed->n, err, err_size)) return -1;
+    if (!ext.Has("n")) return fail(err, err_size, GLTF_EXTENSION_NAME ": missing \"n\"");
+    if (json_large_integer(ext.Get("n"), &packed->n))
+        return fail(err, err_size, GLTF_EXTENSION_NAME ": \"n\" must be an integer (a JSON number up to 2^53, a string "
+                    "of digits above)");
     const tinygltf::Value& method = ext.Get("method");
     if (!method.IsString()) return fail(err, err_size, GLTF_EXTENSION_NAME ": \"method\" must be a string");
     packed->method = sp_method_from_name(method.Get<std::string>().c_str());
@@ -54,18 +81,14 @@ extern "C" int gltf_get_packed(const gltf_doc* doc, size_t mesh, size_t primitiv
         return fail(err, err_size, GLTF_EXTENSION_NAME ": unknown method \"%s\"", method.Get<std::string>().c_str());
     if (ext.Has("axisSamples")) {
         const tinygltf::Value& axes = ext.Get("axisSamples");
-        if (!axes.IsArray() || axes.ArrayLen() + 1 != packed->influences || axes.ArrayLen() > 3)
-            return fail(err, err_size, GLTF_EXTENSION_NAME ": \"axisSamples\" must be an array of influences - 1 "
-                        "integers");
-        for (size_t i = 0; i < axes.ArrayLen(); ++i) {
-            const tinygltf::Value& q = axes.Get(int(i));
-            double d = q.IsNumber() ? q.GetNumberAsDouble() : NAN;
-            if (!std::isfinite(d) || d != std::floor(d) || d < 0 || d > max_safe)
-                return fail(err, err_size, GLTF_EXTENSION_NAME ": \"axisSamples\" entries must be integers");
-            packed->axis_samples[i] = uint64_t(d);
-        }
-    } else if (packed->method == SP_METHOD_ANY && packed->influences > 1) {
-        return fail(err, err_size, GLTF_EXTENSION_NAME ": method \"any\" needs \"axisSamples\"");
+        if (!axes.IsArray() || axes.ArrayLen() > SP_MAX_INFLUENCES - 1)
+            return fail(err, err_size, GLTF_EXTENSION_NAME ": \"axisSamples\" must be an array of at most %d integers",
+                        SP_MAX_INFLUENCES - 1);
+        packed->axis_sample_count = uint32_t(axes.ArrayLen()); // how many the method needs: sp_validate_packed
+        for (size_t i = 0; i < axes.ArrayLen(); ++i)
+            if (json_large_integer(axes.Get(int(i)), &packed->axis_samples[i]))
+                return fail(err, err_size, GLTF_EXTENSION_NAME ": \"axisSamples\" entries must be integers (JSON "
+                            "numbers up to 2^53, strings of digits above)");
     }
     if (ext.Has("meshlets")) {
         const tinygltf::Value& m = ext.Get("meshlets");
@@ -141,6 +164,12 @@ extern "C" int gltf_read_packed(const gltf_doc* doc, const gltf_packed_skin* pac
 
 // ---- writing ----
 
+// A JSON integer up to 2^53, else a string of its digits (docs/extension: "Large integers").
+static ordered_json large_integer(uint64_t v) {
+    if (v <= (uint64_t(1) << 53)) return v;
+    return std::to_string(v);
+}
+
 static ordered_json packed_to_json(const gltf_packed_skin* packed) {
     ordered_json o = ordered_json::object();
     o["vertices"] = packed->vertices;
@@ -148,10 +177,10 @@ static ordered_json packed_to_json(const gltf_packed_skin* packed) {
     o["influences"] = packed->influences;
     o["jointCount"] = packed->joint_count;
     o["method"] = sp_method_name(sp_method(packed->method));
-    o["n"] = packed->n;
+    o["n"] = large_integer(packed->n);
     if (packed->method == SP_METHOD_ANY && packed->influences > 1) {
         ordered_json axes = ordered_json::array();
-        for (uint32_t i = 0; i + 1 < packed->influences; ++i) axes.push_back(packed->axis_samples[i]);
+        for (uint32_t i = 0; i + 1 < packed->influences; ++i) axes.push_back(large_integer(packed->axis_samples[i]));
         o["axisSamples"] = axes;
     }
     o["weightBits"] = packed->weight_bits;

@@ -91,6 +91,7 @@ typedef struct gltf_packed_skin {
     uint32_t method;          /* sp_method */
     uint64_t n;
     uint64_t axis_samples[3]; /* only for any: q2..qK */
+    uint32_t axis_sample_count; /* entries of "axisSamples" (0 when absent) */
     uint32_t weight_bits;
     uint32_t tuple_bits;
     double max_error;         /* informative */
