@@ -199,24 +199,23 @@ static ordered_json* byte_range_of(ordered_json& view) {
     return &view;
 }
 
-static size_t cut_view_bytes(gltf_doc* doc, size_t view_index) {
+// Cuts bytes [begin, begin + length) of buffer b when skinpack writes that buffer and no range
+// but view `skip_view`'s overlaps them; later views (and meshopt ranges) move down. Whole 4-byte
+// words only, so every alignment is kept. Returns the bytes freed.
+static size_t cut_bytes(gltf_doc* doc, int b, size_t begin, size_t length, size_t skip_view) {
     ordered_json& views = doc->json["bufferViews"];
-    ordered_json& range = *byte_range_of(views[view_index]);
-    const ordered_json* buffer = member(range, "buffer");
-    if (!buffer || !buffer->is_number_integer()) return 0;
-    int b = buffer->get<int>();
     std::vector<unsigned char>* bytes = rewritable_bytes(doc, b);
-    size_t begin = json_size(range, "byteOffset"), length = json_size(range, "byteLength") & ~size_t(3);
+    length &= ~size_t(3);
     if (!bytes || begin % 4 || length == 0 || begin + length > bytes->size()) return 0;
     std::vector<std::pair<size_t, size_t>> used;
-    used_ranges(doc, b, view_index, &used);
+    used_ranges(doc, b, skip_view, &used);
     for (const auto& range : used)
         if (range.first < begin + length && range.second > begin) return 0; // shared bytes
     bytes->erase(bytes->begin() + long(begin), bytes->begin() + long(begin + length));
     for (size_t i = 0; i < views.size(); ++i) {
         ordered_json& other = views[i];
         const ordered_json* ob = member(other, "buffer");
-        if (i != view_index && ob && ob->is_number_integer() && ob->get<int>() == b) shift_offset(other, begin + length, length);
+        if (i != skip_view && ob && ob->is_number_integer() && ob->get<int>() == b) shift_offset(other, begin + length, length);
         ordered_json* extensions = other.contains("extensions") ? &other["extensions"] : nullptr;
         for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
             if (!extensions || !extensions->is_object() || !extensions->contains(name)) continue;
@@ -226,6 +225,55 @@ static size_t cut_view_bytes(gltf_doc* doc, size_t view_index) {
         }
     }
     return length;
+}
+
+// Cuts all bytes of bufferView `view_index` (see cut_bytes).
+static size_t cut_view_bytes(gltf_doc* doc, size_t view_index) {
+    ordered_json& range = *byte_range_of(doc->json["bufferViews"][view_index]);
+    const ordered_json* buffer = member(range, "buffer");
+    if (!buffer || !buffer->is_number_integer()) return 0;
+    return cut_bytes(doc, buffer->get<int>(), json_size(range, "byteOffset"), json_size(range, "byteLength"),
+                     view_index);
+}
+
+// An accessor that shares a tightly packed view with others (TEXCOORD_0 and JOINTS_0 back to
+// back): its own bytes are cut from inside the view, which shrinks, and the accessors after it
+// in the view move down. Only when nothing else reads those bytes. Returns the bytes freed.
+static size_t cut_accessor_bytes(gltf_doc* doc, size_t accessor_index, size_t view_index) {
+    ordered_json& accessors = doc->json["accessors"];
+    ordered_json& view = doc->json["bufferViews"][view_index];
+    const ordered_json* buffer = member(view, "buffer");
+    const tinygltf::Accessor& a = doc->model.accessors[accessor_index];
+    size_t element = gltf_component_size(a.componentType) * gltf_type_components(a.type);
+    size_t stride = json_size(view, "byteStride");
+    if (!buffer || !buffer->is_number_integer() || (stride && stride != element) || view.contains("extensions") ||
+        !element)
+        return 0; // interleaved: the bytes are not one range
+    size_t begin = json_size(accessors[accessor_index], "byteOffset"), length = a.count * element;
+    if (length % 4 || begin % 4 || begin + length > json_size(view, "byteLength")) return 0;
+    for (size_t i = 0; i < accessors.size(); ++i) { // every other reader of the view must lie outside the range
+        const ordered_json* v = member(accessors[i], "bufferView");
+        if (i == accessor_index || !v || !v->is_number_unsigned() || v->get<size_t>() != view_index) continue;
+        if (i >= doc->model.accessors.size()) return 0;
+        const tinygltf::Accessor& o = doc->model.accessors[i];
+        size_t o_begin = json_size(accessors[i], "byteOffset");
+        size_t o_element = gltf_component_size(o.componentType) * gltf_type_components(o.type);
+        size_t o_end = o_begin + (o.count ? (o.count - 1) * (stride ? stride : o_element) + o_element : 0);
+        if (o.sparse.isSparse || (o_begin < begin + length && o_end > begin)) return 0;
+    }
+    if (const ordered_json* images = member(doc->json, "images"))
+        for (const ordered_json& image : *images)
+            if (const ordered_json* v = member(image, "bufferView"))
+                if (v->is_number_unsigned() && v->get<size_t>() == view_index) return 0;
+    size_t freed = cut_bytes(doc, buffer->get<int>(), json_size(view, "byteOffset") + begin, length, view_index);
+    if (!freed) return 0;
+    view["byteLength"] = json_size(view, "byteLength") - freed;
+    for (size_t i = 0; i < accessors.size(); ++i) {
+        const ordered_json* v = member(accessors[i], "bufferView");
+        if (i != accessor_index && v && v->is_number_unsigned() && v->get<size_t>() == view_index)
+            shift_offset(accessors[i], begin + freed, freed);
+    }
+    return freed;
 }
 
 // ---- new data ----
@@ -332,6 +380,10 @@ extern "C" size_t gltf_replace_accessor_data(gltf_doc* doc, int accessor_index, 
         freed = cut_view_bytes(doc, size_t(view));
         place_view(doc, doc->json["bufferViews"][size_t(view)], data, bytes, flags);
     } else {
+        const ordered_json* shared = member(accessor, "bufferView");
+        if (shared && shared->is_number_unsigned() && references_known(doc) &&
+            size_t(accessor_index) < doc->model.accessors.size())
+            freed = cut_accessor_bytes(doc, size_t(accessor_index), shared->get<size_t>());
         ordered_json fresh = ordered_json::object();
         place_view(doc, fresh, data, bytes, flags);
         ordered_json& views = gltf_json_array(doc, "bufferViews");

@@ -161,6 +161,10 @@ def without_owned_members(doc, owned, views, lengths):
     for view in doc.get("bufferViews", []):
         if isinstance(view, dict):
             view.pop("byteOffset", None)  # views move when freed bytes are cut before them
+            view.pop("byteLength", None)  # a view shrinks when an owned accessor's bytes inside it are cut
+    for accessor in doc.get("accessors", []):
+        if isinstance(accessor, dict):
+            accessor.pop("byteOffset", None)  # ... and the accessors after it in the view move down
     for buffer in doc.get("buffers", []):
         if isinstance(buffer, dict):
             buffer.pop("byteLength", None)
@@ -193,6 +197,26 @@ def view_bytes(doc, buffers, index):
     return data[offset:offset + view.get("byteLength", 0)]
 
 
+ELEMENT = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
+COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+
+
+def accessor_bytes(doc, buffers, index):
+    """The bytes an accessor reads (None when they cannot be read: no view, no data, malformed)."""
+    try:
+        a = doc["accessors"][index]
+        view = doc["bufferViews"][a["bufferView"]]
+        data = file_bytes(buffers[view["buffer"]])
+        element = ELEMENT[a["componentType"]] * COMPONENTS[a["type"]]
+        stride = view.get("byteStride", element)
+        begin = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+        if data is None or a["count"] < 1:
+            return None
+        return b"".join(bytes(data[begin + i * stride:begin + i * stride + element]) for i in range(a["count"]))
+    except (KeyError, IndexError, TypeError):
+        return None
+
+
 def json_problems(input_path, output_path, via_path=None):
     """Differences outside the extension's members, and changed bytes of views it does not own.
     via_path: the compressed file a decompressed output came from (it says what was owned)."""
@@ -220,6 +244,12 @@ def json_problems(input_path, output_path, via_path=None):
         old = view_bytes(before, before_buffers, index)
         if old is not None and view_bytes(after, after_buffers, index) != old:
             problems.append("bufferView %d bytes changed" % index)
+    for index in range(min(lengths["accessors"], len(after.get("accessors", [])))):
+        if index in owned:
+            continue
+        old = accessor_bytes(before, before_buffers, index)
+        if old is not None and accessor_bytes(after, after_buffers, index) != old:
+            problems.append("accessor %d data changed" % index)
     for key, items in (("images", before.get("images", [])),):
         for index, image in enumerate(items if isinstance(items, list) else []):
             if isinstance(image, dict) and isinstance(image.get("uri"), str) and not image["uri"].startswith("data:"):
