@@ -245,3 +245,11 @@ void cli_json_number(FILE* out, double v) {
     else
         fputs("null", out);
 }
+
+void* cli_grow(void* array, size_t* capacity, size_t count, size_t item_size) {
+    if (count < *capacity) return array;
+    size_t grown = *capacity ? *capacity * 2 : 16;
+    void* moved = realloc(array, grown * item_size);
+    if (moved) *capacity = grown;
+    return moved;
+}

@@ -111,6 +111,38 @@ static int check_budget(const compress_args* args) {
     return 0;
 }
 
+static int is_budget_option(const char* a) {
+    return strcmp(a, "--vertex-bits") == 0 || strcmp(a, "--weight-bits") == 0 || strcmp(a, "--max-error") == 0;
+}
+
+/* --vertex-bits, --weight-bits or --max-error: the one budget (0 in options means "not this"). */
+static int parse_budget(const char* a, const char* value, compress_args* args) {
+    sp_compress_options* o = &args->options;
+    if (strcmp(a, "--vertex-bits") == 0) {
+        o->weight_bits = 0;
+        if (parse_uint(value, SP_MAX_VERTEX_BITS, &o->vertex_bits) || !o->vertex_bits) {
+            fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
+            return -1;
+        }
+    } else if (strcmp(a, "--weight-bits") == 0) {
+        o->vertex_bits = 0;
+        args->weight_bits_given = 1;
+        if (parse_uint(value, SP_MAX_WEIGHT_BITS, &o->weight_bits)) {
+            fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
+            return -1;
+        }
+    } else {
+        char* end = NULL;
+        args->max_error = strtod(value, &end);
+        if (*end || !(args->max_error > 0 && args->max_error < 1)) {
+            fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
+            return -1;
+        }
+        o->vertex_bits = 0;
+    }
+    return 0;
+}
+
 static int parse_args(int argc, char** argv, compress_args* args) {
     memset(args, 0, sizeof(*args));
     sp_compress_options_default(&args->options);
@@ -130,31 +162,8 @@ static int parse_args(int argc, char** argv, compress_args* args) {
                 return -1;
             }
             ++i;
-        } else if (strcmp(a, "--vertex-bits") == 0 && value) {
-            args->options.weight_bits = 0;
-            if (parse_uint(value, SP_MAX_VERTEX_BITS, &args->options.vertex_bits) || !args->options.vertex_bits) {
-                fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
-                return -1;
-            }
-            ++budgets;
-            ++i;
-        } else if (strcmp(a, "--weight-bits") == 0 && value) {
-            args->options.vertex_bits = 0;
-            args->weight_bits_given = 1;
-            if (parse_uint(value, SP_MAX_WEIGHT_BITS, &args->options.weight_bits)) {
-                fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
-                return -1;
-            }
-            ++budgets;
-            ++i;
-        } else if (strcmp(a, "--max-error") == 0 && value) {
-            char* end = NULL;
-            args->max_error = strtod(value, &end);
-            if (*end || !(args->max_error > 0 && args->max_error < 1)) {
-                fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
-                return -1;
-            }
-            args->options.vertex_bits = 0;
+        } else if (is_budget_option(a) && value) {
+            if (parse_budget(a, value, args)) return -1;
             ++budgets;
             ++i;
         } else if (strcmp(a, "--max-influences") == 0 && value) {
@@ -339,6 +348,24 @@ done:
     return rc;
 }
 
+/* Why sp_compress_skin refused a primitive, in terms of the file and the options. */
+static void describe_failure(sp_result r, const compressed_primitive* p, const sp_compress_options* options,
+                             size_t joint_count, char* err, size_t err_size) {
+    uint32_t lo, hi, k = p->skin.influences ? p->skin.influences : options->max_influences;
+    weight_bits_range(options->method, k, &lo, &hi);
+    if (r == SP_ERR_JOINT_OUT_OF_RANGE)
+        snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
+                 p->skin.prepare.error_joint, joint_count);
+    else if (r == SP_ERR_BITS_OUT_OF_RANGE || r == SP_ERR_INVALID_ARGUMENT)
+        snprintf(err, err_size, "the bit budget (%s %u) fits no %s configuration for %u influences (the weights "
+                 "take %u..%u bits; with the tuple index at most %d bits in all)",
+                 options->weight_bits ? "--weight-bits" : "--vertex-bits",
+                 options->weight_bits ? options->weight_bits : options->vertex_bits, sp_method_name(options->method),
+                 k, lo, hi, SP_MAX_VERTEX_BITS);
+    else
+        snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
+}
+
 static int compress_primitive(gltf_doc* doc, const compress_args* args, compressed_primitive* p, char* err,
                               size_t err_size) {
     const gltf_skin_attributes* at = &p->attributes;
@@ -370,19 +397,7 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     sp_result r = sp_compress_skin(joints, weights, vc, stride, joint_count, &options, words, lut, NULL, NULL,
                                    &p->skin, scratch, scratch_size);
     if (r != SP_OK) {
-        uint32_t lo, hi, k = p->skin.influences ? p->skin.influences : options.max_influences;
-        weight_bits_range(options.method, k, &lo, &hi);
-        if (r == SP_ERR_JOINT_OUT_OF_RANGE)
-            snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
-                     p->skin.prepare.error_joint, joint_count);
-        else if (r == SP_ERR_BITS_OUT_OF_RANGE || r == SP_ERR_INVALID_ARGUMENT)
-            snprintf(err, err_size, "the bit budget (%s %u) fits no %s configuration for %u influences (the weights "
-                     "take %u..%u bits; with the tuple index at most %d bits in all)",
-                     options.weight_bits ? "--weight-bits" : "--vertex-bits",
-                     options.weight_bits ? options.weight_bits : options.vertex_bits, sp_method_name(options.method), k,
-                     lo, hi, SP_MAX_VERTEX_BITS);
-        else
-            snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
+        describe_failure(r, p, &options, joint_count, err, err_size);
         goto done;
     }
 
@@ -541,16 +556,13 @@ static long find_skinned(const gltf_doc* doc, const compress_args* args, compres
                 return -1;
             }
             if (!skinned) continue;
-            if (count == capacity) {
-                capacity = capacity ? capacity * 2 : 16;
-                compressed_primitive* grown = realloc(prims, capacity * sizeof(*prims));
-                if (!grown) {
-                    fprintf(stderr, "skinpack compress: out of memory\n");
-                    free(prims);
-                    return -1;
-                }
-                prims = grown;
+            compressed_primitive* grown = cli_grow(prims, &capacity, count, sizeof(*prims));
+            if (!grown) {
+                fprintf(stderr, "skinpack compress: out of memory\n");
+                free(prims);
+                return -1;
             }
+            prims = grown;
             compressed_primitive* p = &prims[count];
             memset(p, 0, sizeof(*p));
             p->mesh = m;

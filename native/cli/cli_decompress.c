@@ -102,12 +102,9 @@ static long decode_all(gltf_doc* doc, const char* input, decoded_primitive** out
                 goto fail;
             }
             if (has == 0) continue;
-            if (count == capacity) {
-                capacity = capacity ? capacity * 2 : 16;
-                decoded_primitive* grown = realloc(list, capacity * sizeof(*list));
-                if (!grown) goto fail;
-                list = grown;
-            }
+            decoded_primitive* grown = cli_grow(list, &capacity, count, sizeof(*list));
+            if (!grown) goto fail;
+            list = grown;
             decoded_primitive* d = &list[count];
             memset(d, 0, sizeof(*d));
             d->mesh = m;
