@@ -295,9 +295,11 @@ SP_API sp_result sp_compress_skin(const uint16_t* joints, const float* weights, 
                                   size_t scratch_size);
 
 /*
- * Decodes packed words back to K joints and K weights per vertex, validating everything a file
- * may get wrong: codes above max_code or of invalid tuples, tuple indices >= lut_size, LUT joints >= joint_count,
- * non-zero padding bits. error_vertex (may be NULL) names the first bad vertex.
+ * Decodes packed words back to K joints and K weights per vertex, validating what the words and
+ * table may get wrong: codes above max_code or of invalid tuples, tuple indices >= lut_size, LUT
+ * joints >= joint_count, non-zero padding bits, a joint in two weighted slots
+ * (SP_ERR_DUPLICATE_JOINT). error_vertex (may be NULL) names the first bad vertex.
+ * sp_validate_packed checks everything else a file may get wrong, too.
  */
 SP_API sp_result sp_decompress_skin(const sp_codec* codec, const uint32_t* words, size_t vertex_count,
                                     uint32_t tuple_bits, const uint16_t* lut, size_t lut_size,

@@ -100,6 +100,11 @@ double sp_any_decode(const sp_codec* codec, uint64_t code, float* weights);
 /* Finish a codec description (code_bits, bits, bounds) once method-specific fields are set. */
 sp_result sp_any_configure(uint32_t influences, const uint64_t* axis_samples, sp_codec* codec);
 
+/* Format rule shared by sp_validate_packed and sp_decompress_skin: 1 (and the two slots) if a
+ * vertex has the same joint in two slots that both carry weight, else 0. */
+int sp_find_duplicate_joint(const uint16_t* joints, const float* weights, uint32_t k, uint32_t* slot,
+                            uint32_t* other_slot);
+
 /* Number of codes per method and parameter, or 0 when it does not fit in 64 bits. */
 sp_u128 sp_oss_code_count(uint64_t n, uint32_t k);
 

@@ -4,7 +4,7 @@
  */
 #include <string.h>
 
-#include "skinpack.h"
+#include "codec_internal.h"
 
 void sp_compress_options_default(sp_compress_options* options)
 {
@@ -208,6 +208,11 @@ sp_result sp_decompress_skin(const sp_codec* codec, const uint32_t* words, size_
             return r;
         }
         memcpy(out_joints + v * k, lut + (size_t)tuple * k, k * sizeof(uint16_t));
+        uint32_t slot, other_slot;
+        if (sp_find_duplicate_joint(out_joints + v * k, out_weights + v * k, k, &slot, &other_slot)) {
+            if (error_vertex) *error_vertex = v;
+            return SP_ERR_DUPLICATE_JOINT;
+        }
     }
     return SP_OK;
 }

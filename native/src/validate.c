@@ -20,14 +20,29 @@ static sp_result fail(sp_validation* report, sp_result result, sp_field field, s
     return result;
 }
 
+int sp_find_duplicate_joint(const uint16_t* joints, const float* weights, uint32_t k, uint32_t* slot,
+                            uint32_t* other_slot)
+{
+    for (uint32_t a = 0; a < k; ++a)
+        for (uint32_t b = a + 1; b < k; ++b)
+            if (joints[a] == joints[b] && weights[a] > 0 && weights[b] > 0) {
+                *slot = a;
+                *other_slot = b;
+                return 1;
+            }
+    return 0;
+}
+
 /* Ranges of the declared integers and the method's own rules for n and axisSamples. */
 static sp_result check_params(const sp_packed_params* p, sp_validation* report)
 {
     if (p->method >= SP_METHOD_COUNT) return fail(report, SP_ERR_UNSUPPORTED_METHOD, SP_FIELD_METHOD, 0, p->method, 0);
     if (p->influences < 1 || p->influences > SP_MAX_INFLUENCES)
-        return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, 0, p->influences, SP_MAX_INFLUENCES);
+        return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, 0, p->influences,
+                    p->influences < 1 ? 1 : SP_MAX_INFLUENCES);
     if (p->joint_count < 1 || p->joint_count > SP_MAX_JOINTS)
-        return fail(report, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, 0, p->joint_count, SP_MAX_JOINTS);
+        return fail(report, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, 0, p->joint_count,
+                    p->joint_count < 1 ? 1 : SP_MAX_JOINTS);
     if (p->weight_bits > SP_MAX_WEIGHT_BITS)
         return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, 0, p->weight_bits, SP_MAX_WEIGHT_BITS);
     if (p->tuple_bits > 32)
@@ -43,7 +58,8 @@ static sp_result check_params(const sp_packed_params* p, sp_validation* report)
     } else {
         uint64_t lo = p->method == SP_METHOD_OSS || p->method == SP_METHOD_POT ? 2 : 1;
         uint64_t hi = p->method == SP_METHOD_OSS ? ((uint64_t)1 << 63) : 64;
-        if (p->n < lo || p->n > hi) return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, 0, p->n, hi);
+        if (p->n < lo || p->n > hi)
+            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, 0, p->n, p->n < lo ? lo : hi);
     }
     for (uint32_t a = 0; a < want_axes; ++a)
         if (p->axis_samples[a] < 2)
@@ -107,13 +123,8 @@ static sp_result decode_vertex(const sp_packed_primitive* prim, size_t v, uint16
     if (sp_decode_weights_batch(codec, &code, 1, weights, NULL) != SP_OK)
         return fail(report, SP_ERR_CODE_OUTSIDE_SIMPLEX, SP_FIELD_VERTICES, v, code, codec->max_code);
     memcpy(joints, prim->lut + (size_t)tuple * k, k * sizeof(uint16_t));
-    for (uint32_t a = 0; a < k; ++a)
-        for (uint32_t b = a + 1; b < k; ++b)
-            if (joints[a] == joints[b] && weights[a] > 0 && weights[b] > 0) {
-                report->slot = a;
-                report->other_slot = b;
-                return fail(report, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, v, joints[a], tuple);
-            }
+    if (sp_find_duplicate_joint(joints, weights, k, &report->slot, &report->other_slot))
+        return fail(report, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, v, joints[report->slot], tuple);
     return SP_OK;
 }
 
@@ -140,7 +151,8 @@ static sp_result check_meshlet_limits(const sp_packed_meshlets* ml, uint32_t lim
     const uint32_t declared[3] = {ml->max_vertices, ml->max_triangles, ml->max_joints};
     for (uint32_t i = 0; i < 3; ++i) {
         if (declared[i] && (declared[i] < lowest[i] || declared[i] > highest[i]))
-            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, i, declared[i], highest[i]);
+            return fail(report, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, i, declared[i],
+                        declared[i] < lowest[i] ? lowest[i] : highest[i]);
         limits[i] = declared[i] ? declared[i] : highest[i];
     }
     limits[3] = 255; /* local tuple indices are u8 */

@@ -68,7 +68,12 @@ size_t sp_format_validation(const sp_validation* report, char* buffer, size_t bu
     case SP_ERR_TOO_MANY_JOINTS:
         if (report->field == SP_FIELD_MAX_ERROR)
             return (size_t)snprintf(buffer, buffer_size, "%s: not a number in [0, 1]", name);
-        return (size_t)snprintf(buffer, buffer_size, "%s: %llu out of range (limit %llu)%s", name, value, limit, where);
+        if (value < limit)
+            return (size_t)snprintf(buffer, buffer_size, "%s: %llu below the minimum %llu%s", name, value, limit, where);
+        if (limit == SP_MAX_WEIGHT_BITS && (report->field == SP_FIELD_N || report->field == SP_FIELD_AXIS_SAMPLES))
+            return (size_t)snprintf(buffer, buffer_size, "%s: %llu needs weight codes of more than 64 bits%s", name,
+                                    value, where);
+        return (size_t)snprintf(buffer, buffer_size, "%s: %llu above the maximum %llu%s", name, value, limit, where);
     default:
         return (size_t)snprintf(buffer, buffer_size, "%s%s%s%s", name, *name ? ": " : "",
                                 sp_result_string((sp_result)report->result), where);

@@ -22,6 +22,11 @@ static void abi_and_rules(void)
     CHECK(sp_check_abi(SP_VERSION + 1, sizes, 0, &bad) == SP_ERR_ABI_MISMATCH && bad == SP_STRUCT_COUNT);
     CHECK(sp_check_abi(SP_VERSION, sizes, SP_STRUCT_MESHLET, &bad) == SP_OK); /* an older, shorter list */
 
+    for (int r = 0; r < SP_RESULT_COUNT; ++r) /* every code, the validation ones included, has its message */
+        CHECK_MSG(strcmp(sp_result_string((sp_result)r), "unknown result code") != 0, "result %d", r);
+    for (int f = 1; f < SP_FIELD_COUNT; ++f) CHECK_MSG(sp_field_name((sp_field)f)[0] != 0, "field %d", f);
+    CHECK(sp_field_name(SP_FIELD_COUNT)[0] == 0);
+
     CHECK(sp_joint_bytes(0) == 0 && sp_joint_bytes(1) == 1 && sp_joint_bytes(256) == 1);
     CHECK(sp_joint_bytes(257) == 2 && sp_joint_bytes(65535) == 2 && sp_joint_bytes(65536) == 0);
 
@@ -164,18 +169,18 @@ static void valid_primitives(void)
 static void bad_parameters(const packed* base)
 {
     EXPECT(bad.params.method = SP_METHOD_COUNT, SP_ERR_UNSUPPORTED_METHOD, SP_FIELD_METHOD, "method: unknown");
-    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 out of range");
+    EXPECT(bad.params.influences = 5, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences: 5 above the maximum 4");
     EXPECT(bad.params.influences = (uint64_t)1 << 32 | 4, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_INFLUENCES, "influences");
-    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 out of range");
+    EXPECT(bad.params.joint_count = 0, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount: 0 below the minimum 1");
     EXPECT(bad.params.joint_count = 70000, SP_ERR_TOO_MANY_JOINTS, SP_FIELD_JOINT_COUNT, "jointCount");
-    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65");
+    EXPECT(bad.params.weight_bits = 65, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_WEIGHT_BITS, "weightBits: 65 above the maximum 64");
     EXPECT(bad.params.weight_bits -= 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits");
     EXPECT(bad.params.tuple_bits += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_TUPLE_BITS, "tupleBits");
     EXPECT(bad.params.tuple_bits = 33, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_TUPLE_BITS, "tupleBits: 33");
-    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 out of range");
+    EXPECT(bad.params.n = 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 1 below the minimum 2");
     EXPECT(bad.params.n = ((uint64_t)1 << 63) + 1, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n:");
     EXPECT(bad.params.n += 1, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_WEIGHT_BITS, "weightBits"); /* n of more bits */
-    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000"); /* K = 4: > 64 bits */
+    EXPECT(bad.params.n = 20000000, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_N, "n: 20000000 needs weight codes of more than 64 bits"); /* K = 4: > 64 bits */
     EXPECT(bad.params.axis_sample_count = 3, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_AXIS_SAMPLES, "axisSamples");
     EXPECT((bad.params.has_max_error = 1, bad.params.max_error = NAN), SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MAX_ERROR,
            "maxError: not a number");
@@ -241,6 +246,13 @@ static void bad_data(packed* base)
     char text[64];
     snprintf(text, sizeof(text), "carries weight in slots 0 and 1 (tuple %u) at vertex", tuple);
     EXPECT(bad.lut = lut, SP_ERR_DUPLICATE_JOINT, SP_FIELD_VERTICES, text);
+    /* the older decoder applies the same rule */
+    static uint16_t joints[4 * V];
+    static float weights[4 * V];
+    size_t bad_vertex = V;
+    CHECK(sp_decompress_skin(&base->info.codec, base->words, V, tb, lut, prim->lut_size, JOINTS, joints, weights,
+                             &bad_vertex) == SP_ERR_DUPLICATE_JOINT);
+    CHECK(bad_vertex <= v);
 }
 
 /* Grid methods: an unsorted grid point; Any: a point past the simplex (w1 < 0). */
@@ -324,7 +336,7 @@ static void meshlets(packed* base)
     EXPECT(bad.meshlets = &b.view, SP_ERR_PARAMETER_MISMATCH, SP_FIELD_MESHLET_TUPLES, "where the vertex decodes to");
     b = a;
     b.view.max_joints = 300;
-    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300");
+    EXPECT(bad.meshlets = &b.view, SP_ERR_BITS_OUT_OF_RANGE, SP_FIELD_MESHLET_LIMITS, "meshlets limits: 300 above the maximum 255");
     base->prim.meshlets = NULL;
 }
 
