@@ -37,9 +37,10 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
                              uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
                              size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size);
 
-/* The same, reading the arrays from the document. */
-int cli_decode_packed(const gltf_doc* doc, size_t mesh, const gltf_packed_skin* packed, cli_decoded_skin* out,
-                      char* err, size_t err_size);
+/* The same, reading the arrays from the document; the vertex count must be the primitive's
+ * (its POSITION count). */
+int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
+                      cli_decoded_skin* out, char* err, size_t err_size);
 
 void cli_decoded_skin_free(cli_decoded_skin* skin);
 
@@ -65,6 +66,10 @@ double cli_lut_bits_per_vertex(size_t lut_size, uint32_t influences, uint32_t jo
  * ignored; a joint missing on one side counts with weight 0). */
 double cli_vertex_difference(const uint16_t* joints_a, const float* weights_a, size_t k_a, const uint16_t* joints_b,
                              const float* weights_b, size_t k_b);
+
+/* Makes room for one more item in a malloc'ed array of count items (doubling *capacity).
+ * Returns the array, moved or not, or NULL when out of memory (the old array is still valid). */
+void* cli_grow(void* array, size_t* capacity, size_t count, size_t item_size);
 
 /* Size of a file in bytes, 0 if it cannot be read. */
 size_t cli_file_size(const char* path);

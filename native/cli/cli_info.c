@@ -104,7 +104,7 @@ done:
 static int info_packed(const gltf_doc* doc, size_t mesh, size_t primitive, primitive_info* info, char* err,
                        size_t err_size) {
     cli_decoded_skin skin;
-    if (cli_decode_packed(doc, mesh, &info->ext, &skin, err, err_size)) return -1;
+    if (cli_decode_packed(doc, mesh, primitive, &info->ext, &skin, err, err_size)) return -1;
     uint32_t k = skin.influences;
     info->packed = 1;
     info->vertices = skin.vertex_count;
@@ -304,12 +304,9 @@ int skinpack_cmd_info(int argc, char** argv) {
                 fprintf(stderr, "skinpack info: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto done;
             }
-            if (count == capacity) {
-                capacity = capacity ? capacity * 2 : 16;
-                primitive_info* grown = realloc(infos, capacity * sizeof(*infos));
-                if (!grown) goto done;
-                infos = grown;
-            }
+            primitive_info* grown = cli_grow(infos, &capacity, count, sizeof(*infos));
+            if (!grown) goto done;
+            infos = grown;
             infos[count++] = info;
         }
     }
