@@ -276,20 +276,18 @@ static inline __attribute__((always_inline)) uint64_t encode_one(const sp_codec*
         float decoded[SP_MAX_INFLUENCES];
         code = sp_any_encode(codec, weights);
         if (significant) {
+            /* Any's axes round on grids of their own: a slot can decode to 0 with weight after it */
             sp_any_decode(codec, code, decoded);
             uint8_t count = 1;
-            while (count < k && decoded[count] > 0) ++count;
+            for (uint8_t i = 1; i < k; ++i)
+                if (decoded[i] > 0) count = (uint8_t)(i + 1);
             *significant = count;
         }
         return code;
     }
     sp_grid_quantize(weights, k, codec->scale, q);
     code = codec->method == SP_METHOD_OSS ? sp_oss_pack(codec->n, k, q) : sp_grid_pack(codec, q);
-    if (significant) {
-        uint8_t count = 1;
-        while (count < k && q[count] > 0) ++count;
-        *significant = count;
-    }
+    if (significant) *significant = sp_grid_significant(q, k);
     return code;
 }
 

@@ -53,6 +53,17 @@ static inline __attribute__((always_inline)) void sp_grid_quantize(const float* 
     sp_grid_quantize_general(weights, k, s, q);
 }
 
+/* How many leading slots of grid point q carry weight: one past the last non-zero one, so that
+ * every slot from there on is zero (don't-care for the tuple table). For the sorted grids that
+ * is also the first zero slot. */
+static inline uint8_t sp_grid_significant(const uint64_t* q, uint32_t k)
+{
+    uint8_t count = 1;
+    for (uint32_t i = 1; i < k; ++i)
+        if (q[i] > 0) count = (uint8_t)(i + 1);
+    return count;
+}
+
 /* Fixed/Cube/POT: pack and unpack the integer grid coordinates q[0..k-1] (q[0] = largest). */
 uint64_t sp_grid_pack(const sp_codec* codec, const uint64_t* q);
 void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q);

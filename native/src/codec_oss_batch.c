@@ -46,11 +46,7 @@ uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t*
     uint64_t q[SP_MAX_INFLUENCES] = {0};
     uint32_t k = codec->influences;
     sp_grid_quantize(weights, k, codec->scale, q);
-    if (significant) {
-        uint8_t count = 1;
-        while (count < k && q[count] > 0) ++count;
-        *significant = count;
-    }
+    if (significant) *significant = sp_grid_significant(q, k);
     return sp_oss_pack(codec->n, k, q);
 }
 
