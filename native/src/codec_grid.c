@@ -43,25 +43,26 @@ static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint6
     for (uint32_t i = 0; i < k; ++i) sum += weights[i];
     if (!(sum > 0)) sum = 1;
 
-    sp_u128 total = 0;
+    sp_u128 total = sp_u128_from(0), grid = sp_u128_from(s);
     long double scale = (long double)s / (long double)sum;
     for (uint32_t i = 0; i < k; ++i) {
         q[i] = floor_clamped((long double)weights[i] * scale, s, &remainder[i]);
-        total += q[i];
+        total = sp_u128_add_u64(total, q[i]);
     }
     order_by_remainder(remainder, k, order);
     /* The deficit is 0..k-1 for proper input; degenerate input (a sum of zero or rounding of
      * huge grids) is settled in bulk, never one grid step at a time. */
-    if (total < s) {
-        uint64_t deficit = (uint64_t)(s - total);
+    if (sp_u128_less(total, grid)) {
+        uint64_t deficit = sp_u128_low(sp_u128_sub(grid, total));
         for (uint32_t i = 0; i < k; ++i) q[i] += deficit / k;
         for (uint32_t t = 0; t < deficit % k; ++t) q[order[t]]++;
     }
-    for (uint32_t t = 0; total > s && t < k; ++t) { /* smallest remainders give back first */
+    for (uint32_t t = 0; sp_u128_less(grid, total) && t < k; ++t) { /* smallest remainders give back first */
         uint32_t slot = order[k - 1 - t];
-        uint64_t take = (uint64_t)(total - s) < q[slot] ? (uint64_t)(total - s) : q[slot];
+        sp_u128 excess = sp_u128_sub(total, grid); /* < 4s: the low half unless s is near 2^64 */
+        uint64_t take = sp_u128_high(excess) || sp_u128_low(excess) >= q[slot] ? q[slot] : sp_u128_low(excess);
         q[slot] -= take;
-        total -= take;
+        total = sp_u128_sub(total, sp_u128_from(take));
     }
     /* Keep descending order even where the rounding loops above had to wrap around. */
     for (uint32_t i = 1; i < k; ++i)

@@ -4,8 +4,7 @@
 
 #include "skinpack.h"
 
-/* 128-bit intermediates: the OSS closed forms overflow 64 bits for budgets near 64 bits. */
-typedef unsigned __int128 sp_u128;
+#include "platform.h" /* SP_INLINE, sp_u128 (the OSS closed forms overflow 64 bits near 64-bit codes) */
 
 /* Float rounding of the input weights and of the decoded floats, added to every bound. */
 #define SP_FLOAT_SLACK 3.6e-7
@@ -19,8 +18,7 @@ void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint
  * 2^50 (double is exact enough) floor by conversion, then add one to the d largest remainders
  * chosen by rank instead of by sorting.
  */
-static inline __attribute__((always_inline)) void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s,
-                                                                   uint64_t* q)
+SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     if (s < ((uint64_t)1 << 50)) {
         double remainder[SP_MAX_INFLUENCES], sum = 0;

@@ -26,26 +26,38 @@ static inline uint64_t layer_base_small(uint64_t n, uint64_t k)
     return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9;
 }
 
+/* u(k) = floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9) in 128 bits, k <= (N + 1)/2 (so
+ * N - 2k + 3 > 0; 4k^2 - 9k + 6 > 0 for every k). */
+static sp_u128 layer_numerator_over_9(uint64_t n, uint64_t k)
+{
+    sp_u128 nn = sp_u128_from(n), kk = sp_u128_from(k);
+    sp_u128 width = sp_u128_sub(sp_u128_add_u64(nn, 3), sp_u128_mul_u64(kk, 2)); /* N - 2k + 3 */
+    sp_u128 outer = sp_u128_mul(sp_u128_mul_u64(sp_u128_mul(nn, kk), 3), width);
+    sp_u128 inner = sp_u128_add_u64(sp_u128_mul(sp_u128_sub(sp_u128_mul_u64(kk, 4), sp_u128_from(9)), kk), 6);
+    sp_u128 numerator = sp_u128_add_u64(sp_u128_add(outer, sp_u128_mul(kk, inner)), 2);
+    return sp_u128_div_u64(numerator, 9);
+}
+
 uint64_t sp_oss_row_base(uint64_t n, uint64_t j)
 {
     /* floor((-3j^2 + 2j + 4jN + 1) / 4); the numerator is positive for rows inside the triangle. */
     if (n < OSS_SMALL_N && j < OSS_SMALL_N) return row_base_small(n, j);
-    sp_u128 jj = j, nn = n;
-    return (uint64_t)((4 * jj * nn + 2 * jj + 1 - 3 * jj * jj) / 4);
+    /* (4N + 2 - 3j) j + 1, positive inside the triangle */
+    sp_u128 slope = sp_u128_sub(sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 4), 2), sp_u128_mul_u64(sp_u128_from(j), 3));
+    sp_u128 numerator = sp_u128_add_u64(sp_u128_mul_u64(slope, j), 1);
+    return sp_u128_low(sp_u128_div_u64(numerator, 4));
 }
 
 uint64_t sp_oss_triangle_count(uint64_t n)
 {
-    sp_u128 nn = n;
-    return (uint64_t)((nn * nn + nn + 1) / 3);
+    return sp_u128_low(sp_oss_code_count(n, 3));
 }
 
 uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
     if (n < OSS_SMALL_N) return layer_base_small(n, k);
-    sp_u128 nn = n, kk = k;
-    return (uint64_t)((3 * nn * kk * (nn - 2 * kk + 3) + kk * (4 * kk * kk - 9 * kk + 6) + 2) / 9);
+    return sp_u128_low(layer_numerator_over_9(n, k));
 }
 
 uint64_t sp_oss_tetrahedron_count(uint64_t n)
@@ -55,17 +67,16 @@ uint64_t sp_oss_tetrahedron_count(uint64_t n)
 
 sp_u128 sp_oss_code_count(uint64_t n, uint32_t k)
 {
-    sp_u128 nn = n;
     switch (k) {
-    case 1: return 1;
-    case 2: return nn;
-    case 3: return (nn * nn + nn + 1) / 3;
-    case 4: {
-        /* u((N+1)/2) in 128 bits: N up to ~2^43 before this overflows, far past 64-bit codes. */
-        sp_u128 kk = (nn + 1) / 2;
-        return (3 * nn * kk * (nn - 2 * kk + 3) + kk * (4 * kk * kk - 9 * kk + 6) + 2) / 9;
+    case 1: return sp_u128_from(1);
+    case 2: return sp_u128_from(n);
+    case 3: { /* (N^2 + N + 1) / 3 */
+        sp_u128 nn = sp_u128_from(n);
+        return sp_u128_div_u64(sp_u128_add_u64(sp_u128_mul(nn, sp_u128_add_u64(nn, 1)), 1), 3);
     }
-    default: return 0;
+    case 4: /* u((N+1)/2), whose numerator fits 128 bits for N < 2^42, far past 64-bit codes */
+        return n < ((uint64_t)1 << 42) ? layer_numerator_over_9(n, n / 2 + (n & 1)) : sp_u128_from(0);
+    default: return sp_u128_from(0);
     }
 }
 
@@ -98,10 +109,11 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w)
         uint64_t two_n1 = 2 * n + 1;
         mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w);
         apex = (double)two_n1;
-    } else {
-        sp_u128 two_n1 = 2 * (sp_u128)n + 1;
-        mirrored = (double)(two_n1 * two_n1 + 3 - 12 * (sp_u128)w);
-        apex = (double)two_n1;
+    } else { /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
+        sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
+        sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
+        mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
+        apex = sp_u128_to_double(two_n1);
     }
     double estimate = (apex - sqrt(mirrored)) / 3.0;
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
@@ -139,9 +151,10 @@ static uint64_t oss_find_layer(uint64_t n, uint64_t code)
     if (n < OSS_SMALL_N) { /* everything below 2^63: no 128-bit conversions */
         uint64_t m = n + 1;
         v = (double)(int64_t)(4 * m * m * m + 6 * m * m + 16 - 72 * code);
-    } else {
-        sp_u128 m = (sp_u128)n + 1;
-        v = (double)(4 * m * m * m + 6 * m * m + 16 - 72 * (sp_u128)code);
+    } else { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
+        sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
+        sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 4), sp_u128_mul_u64(m2, 6));
+        v = sp_u128_to_double(sp_u128_sub(sp_u128_add_u64(cubic, 16), sp_u128_mul_u64(sp_u128_from(code), 72)));
     }
     double root = v > 2 ? sqrt(v * (v - 2)) : 0;
     double c = n < OSS_SMALL_N ? cube_root(v - 1 + root) : cbrt(v - 1 + root);
