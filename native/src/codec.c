@@ -297,12 +297,6 @@ uint64_t sp_encode_weights(const sp_codec* codec, const float* weights)
     return encode_one(codec, weights, codec->influences, NULL);
 }
 
-static void grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
-{
-    double inv = 1.0 / (double)scale;
-    for (uint32_t i = 0; i < k; ++i) weights[i] = (float)((double)q[i] * inv);
-}
-
 void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
 {
     uint32_t k = codec->influences;
@@ -311,10 +305,11 @@ void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
         weights[0] = 1.0f;
     } else if (codec->method == SP_METHOD_ANY) {
         sp_any_decode(codec, code, weights);
+    } else if (codec->method == SP_METHOD_OSS) {
+        sp_oss_decode_one(codec, code, weights);
     } else {
-        if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);
-        else sp_grid_unpack(codec, code, q);
-        grid_to_weights(q, k, codec->scale, weights);
+        sp_grid_unpack(codec, code, q);
+        sp_grid_to_weights(q, k, codec->scale, weights);
     }
 }
 
@@ -339,14 +334,14 @@ static int decode_valid(const sp_codec* codec, uint64_t code, float* weights)
             sum = sp_u128_add_u64(sum, q[i]);
         }
         if (sp_u128_high(sum) || sp_u128_low(sum) != codec->scale) return 0;
-        grid_to_weights(q, k, codec->scale, decoded);
+        sp_grid_to_weights(q, k, codec->scale, decoded);
     }
     for (uint32_t i = 0; i < k; ++i) weights[i] = decoded[i];
     return 1;
 }
 
 sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weights, size_t vertex_count,
-                                      uint64_t* codes, uint8_t* significant, sp_oss_isa widest)
+                                      uint64_t* codes, uint8_t* significant, sp_isa widest)
 {
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
@@ -365,7 +360,7 @@ sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weight
 }
 
 sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,
-                                      float* weights, size_t* error_vertex, sp_oss_isa widest)
+                                      float* weights, size_t* error_vertex, sp_isa widest)
 {
     if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
@@ -382,11 +377,11 @@ sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* cod
 sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
                                   uint64_t* codes, uint8_t* significant)
 {
-    return sp_encode_weights_batch_isa(codec, weights, vertex_count, codes, significant, SP_OSS_ISA_AVX512);
+    return sp_encode_weights_batch_isa(codec, weights, vertex_count, codes, significant, SP_ISA_AVX512);
 }
 
 sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count, float* weights,
                                   size_t* error_vertex)
 {
-    return sp_decode_weights_batch_isa(codec, codes, vertex_count, weights, error_vertex, SP_OSS_ISA_AVX512);
+    return sp_decode_weights_batch_isa(codec, codes, vertex_count, weights, error_vertex, SP_ISA_AVX512);
 }

@@ -4,6 +4,7 @@
 
 #include "skinpack.h"
 
+#include "cpu_features.h"
 #include "platform.h" /* SP_INLINE, sp_u128 (the OSS closed forms overflow 64 bits near 64-bit codes) */
 
 /* Float rounding of the input weights and of the decoded floats, added to every bound. */
@@ -70,36 +71,45 @@ void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q);
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q);
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q);
 
-/* Instruction sets of the batch paths, in order. The public batch functions use the widest the
- * CPU has; the *_isa forms take a cap so tests can check every path the CPU has against the
- * scalar code (an argument, not a setting: the library keeps no state). */
-typedef enum { SP_OSS_ISA_SCALAR, SP_OSS_ISA_AVX2, SP_OSS_ISA_AVX512 } sp_oss_isa;
-
+/* The batch forms with a cap on the vector path (SP_ISA_SCALAR: none), so one test binary
+ * checks every path the CPU has against the scalar code; the public forms pass SP_ISA_AVX512. */
 sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weights, size_t vertex_count,
-                                      uint64_t* codes, uint8_t* significant, sp_oss_isa widest);
+                                      uint64_t* codes, uint8_t* significant, sp_isa widest);
 sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,
-                                      float* weights, size_t* error_vertex, sp_oss_isa widest);
+                                      float* weights, size_t* error_vertex, sp_isa widest);
 
-/* OSS batch fast paths (codec_oss_batch.c): encode or decode a prefix of the vertices with
- * vector code where the CPU, the cap and the codec allow it, bit-identical to the scalar path;
- * return how many leading vertices were done (0 when not applicable). Decode stops before a
- * block holding a code above max_code, so the scalar loop reports it. */
+/* OSS batch dispatch (codec_oss_batch.c): encode or decode a prefix of the vertices with vector
+ * code where the CPU, the cap and the codec allow it, bit-identical to the scalar path; return
+ * how many leading vertices were done (0 when not applicable). Decode stops before a block
+ * holding a code above max_code, so the scalar loop reports it. */
 size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                           uint8_t* significant, sp_oss_isa widest);
+                           uint8_t* significant, sp_isa widest);
 size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
-                           sp_oss_isa widest);
+                           sp_isa widest);
+/* Whether the vector paths are exact for this codec (OSS, K = 2..4, N in range). */
+int sp_oss_batch_supported(const sp_codec* codec);
 
-/* The scalar encode of one vertex (grid rounding, significant count, OSS index): what vector
- * lanes that cannot prove themselves exact fall back to. significant may be NULL. */
-uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant);
-
-/* The AVX-512 batch paths (codec_oss_batch_avx512.c), blocks of 8 vertices, same contract as
- * the functions above for a codec they support; call only where sp_oss_has_avx512(). */
+/* The per-ISA paths (codec_oss_batch_avx2.c: blocks of 4; codec_oss_batch_avx512.c: blocks of
+ * 8), same contract; call only where sp_cpu_isa() has the ISA and the codec is supported. */
+size_t sp_oss_encode_avx2(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                          uint8_t* significant);
+size_t sp_oss_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
 size_t sp_oss_encode_avx512(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                             uint8_t* significant);
 size_t sp_oss_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
-int sp_oss_has_avx512(void);
 
+/* The scalar OSS encode (grid rounding, significant count, index; significant may be NULL) and
+ * decode (codec_oss.c) of one vertex: what the batch loops and the vector lanes that cannot
+ * prove themselves exact use. */
+uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant);
+void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights);
+
+/* Grid coordinates to weights, q[i] / s rounded once to float: every decoder's last step. */
+static inline void sp_grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
+{
+    double inverse = 1.0 / (double)scale;
+    for (uint32_t i = 0; i < k; ++i) weights[i] = (float)((double)q[i] * inverse);
+}
 
 /* Any AABB works on floats directly (its axes do not share a grid). */
 uint64_t sp_any_encode(const sp_codec* codec, const float* weights);

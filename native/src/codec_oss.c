@@ -192,3 +192,19 @@ void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
     q[1] = i + row + layer;
     q[0] = 2 * (n - 1) - q[1] - q[2] - (k == 4 ? q[3] : 0);
 }
+
+uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
+{
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    uint32_t k = codec->influences;
+    sp_grid_quantize(weights, k, codec->scale, q);
+    if (significant) *significant = sp_grid_significant(q, k);
+    return sp_oss_pack(codec->n, k, q);
+}
+
+void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights)
+{
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    sp_oss_unpack(codec->n, codec->influences, code, q);
+    sp_grid_to_weights(q, codec->influences, codec->scale, weights);
+}
