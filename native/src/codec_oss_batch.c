@@ -6,11 +6,15 @@
  */
 #include "codec_internal.h"
 
-/* Largest N per K for which every intermediate (numerators of u(k) and s_N(j), V of the layer
- * root, codes) stays below 2^50: K = 4 numerators are < 3N^3/8 + N^3/2, K = 3 ones < 3N^2. */
+/* Largest N per K for which the double lanes are exact (codec_oss_simd.h): every value with a
+ * fractional quarter or half (row and layer numerators, the row root's argument) below 2^51,
+ * every integer (the layer root's argument 8(N+1)^3 + ...) below 2^53, codes below 2^52 (AVX2's
+ * conversion), and the layer numerator 9 u(k) + 12 below 2^50.3 for its floor by multiplication.
+ * K = 3: rows s_N(j) < N^2/3 + N, apex^2 = (2N + 1)^2 < 2^50 at N = 2^24.
+ * K = 4: 8(N + 1)^3 < 2^52.8 and 9 u(k) < 2^48.8 at N = 3 * 2^15 (codes of up to 45 bits). */
 #define BATCH_MAX_N2 ((uint64_t)1 << 48)
-#define BATCH_MAX_N3 ((uint64_t)1 << 23)
-#define BATCH_MAX_N4 ((uint64_t)1 << 15)
+#define BATCH_MAX_N3 ((uint64_t)1 << 24)
+#define BATCH_MAX_N4 ((uint64_t)3 << 15)
 
 int sp_oss_batch_supported(const sp_codec* codec)
 {

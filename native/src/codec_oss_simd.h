@@ -6,7 +6,7 @@
  * Results are bit-identical to the scalar path (sp_grid_quantize + sp_oss_pack, and
  * sp_oss_unpack + sp_grid_to_weights): the rounding runs in double lanes with the scalar's
  * exact operation order, and the OSS index arithmetic runs in double lanes too, where every
- * intermediate is an integer or a quarter below 2^50 and thus exact in any order (Horner forms,
+ * intermediate is an integer or a quarter small enough (codec_oss_batch.c) to be exact in any order (Horner forms,
  * explicit FMAs). Decode's layer and row *estimates* differ from the scalar ones (no layer
  * square root, no divisions, shifted arguments): exact integer checks decide every lane. A lane
  * whose inputs leave that exact regime (odd weights, a code the estimate misses) is redone by
@@ -190,7 +190,7 @@ SIMD_FN size_t SIMD_NAME(encode)(const sp_codec* codec, const float* weights, si
  * check sends them to the scalar code.
  */
 
-/* x = 2(V - 1) for code + 17/18: an integer below 2^49, so the fused product is exact. */
+/* x = 2(V - 1) for code + 17/18: an integer below 2^53 (see BATCH_MAX_N4), so the fused product is exact. */
 SP_INLINE SIMD_FN vec layer_argument(double n, vec code)
 {
     double m = n + 1;

@@ -126,7 +126,7 @@ static void random_tuple(uint32_t k, uint64_t s, float* w)
 /* Millions of random tuples on the bench budgets and at the edges of the vector path. */
 static void random_tuples(void)
 {
-    static const uint32_t budgets[] = {8, 16, 22, 26, 30, 38, 44, 52, 64};
+    static const uint32_t budgets[] = {8, 16, 22, 26, 30, 38, 44, 45, 46, 52, 64};
     size_t count = 300000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -148,7 +148,7 @@ static void random_tuples(void)
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 23}, {4, (uint64_t)1 << 15}};
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -180,7 +180,7 @@ static void range_edges(void)
  * there for large N), each lane decoded or redone as the scalar code decodes it. */
 static void estimate_boundaries(void)
 {
-    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}};
+    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
     for (size_t e = 0; e < sizeof(cases) / sizeof(cases[0]); ++e) {
         sp_codec c;
         uint32_t k = cases[e].k;
@@ -288,6 +288,8 @@ static void path_coverage(sp_isa isa)
         if (isa >= SP_ISA_AVX512 && cpu >= SP_ISA_AVX512) expected = 16 + 4; /* two blocks of 8, one of 4 */
         else if (isa >= SP_ISA_AVX2 && cpu >= SP_ISA_AVX2) expected = 20;
         CHECK_MSG(sp_oss_encode_batch(&c, w, 23, codes, NULL, isa) == expected, "K=%u isa %d encode prefix", k, (int)isa);
+        /* valid codes (an unsorted random tuple may have encoded past max_code) */
+        for (size_t v = 0; v < 23; ++v) codes[v] = rng_next() % (c.max_code + 1);
         CHECK_MSG(sp_oss_decode_batch(&c, codes, 23, w, isa) == expected, "K=%u isa %d decode prefix", k, (int)isa);
     }
 }
