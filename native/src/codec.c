@@ -321,6 +321,10 @@ static int decode_valid(const sp_codec* codec, uint64_t code, float* weights)
     uint32_t k = codec->influences;
     float decoded[SP_MAX_INFLUENCES];
     if (code > codec->max_code) return 0;
+    if (codec->method == SP_METHOD_OSS && k > 1) { /* a bijection: every code in range is a sorted grid point */
+        sp_oss_decode_one(codec, code, weights);
+        return 1;
+    }
     if (k == 1 || codec->method == SP_METHOD_ANY) {
         sp_decode_weights(codec, code, decoded);
         if (decoded[0] < -1e-6f) return 0; /* Any: the stored weights sum past 1 */

@@ -101,7 +101,7 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
  * relevant root is the one left of the apex.) */
-static uint64_t oss_find_row(uint64_t n, uint64_t w)
+static uint64_t oss_find_row(uint64_t n, uint64_t w, uint64_t* base)
 {
     uint64_t rows = (2 * n + 1) / 3;
     double mirrored, apex;
@@ -115,78 +115,102 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w)
         mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
         apex = sp_u128_to_double(two_n1);
     }
-    double estimate = (apex - sqrt(mirrored)) / 3.0;
+    if (n < OSS_SMALL_N) mirrored -= 10.5; /* for w + 7/8 (see row_estimate in codec_oss_simd.h): one step, not two */
+    double estimate = (apex - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
-    if (n < OSS_SMALL_N) {
-        while (j + 1 < rows && row_base_small(n, j + 1) <= w) ++j;
-        while (j > 0 && row_base_small(n, j) > w) --j;
+    if (n < OSS_SMALL_N) { /* the estimate is the row but for rounding: one check each way */
+        uint64_t at = row_base_small(n, j);
+        while (j > 0 && at > w) at = row_base_small(n, --j);
+        for (uint64_t next; j + 1 < rows && (next = row_base_small(n, j + 1)) <= w; ++j) at = next;
+        *base = at;
         return j;
     }
     while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
     while (j > 0 && sp_oss_row_base(n, j) > w) --j;
+    *base = sp_oss_row_base(n, j);
     return j;
+}
+
+/*
+ * cbrt(x) + 1/cbrt(x) for x >= 1 to ~1e-8 without a division or square root, as the AVX2 path
+ * computes it (codec_oss_batch_avx2.c, root_start/root_finish): z ~ x^(-1/3) from the float
+ * exponent/3 bit trick and a third-order step, then c + z with c = x z^2 corrected by one
+ * Newton step's first-order term.
+ */
+static inline double cube_root_sum(double x)
+{
+    float xf = (float)x, zf;
+    int32_t bits;
+    memcpy(&bits, &xf, sizeof(bits));
+    bits = 1419916032 - (int32_t)((float)bits * (1.0f / 3.0f));
+    memcpy(&zf, &bits, sizeof(zf));
+    float r = 1.0f - (xf * zf) * (zf * zf);
+    zf += (zf * r) * (r * (2.0f / 9.0f) + 1.0f / 3.0f);
+    double z = zf, xz = x * z, c = xz * z, rd = 1.0 - xz * (z * z);
+    return (c + z) + rd * (c * (2.0 / 3.0) + z * (1.0 / 3.0));
+}
+
+/* The layer estimate of the vector paths for N < OSS_SMALL_N: (2N + 3 - t) / 4 with
+ * t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code for code + 17/18, which
+ * puts every code strictly inside its layer (see codec_oss_simd.h): one check each way, no
+ * square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
+static uint64_t estimate_layer_small(uint64_t n, uint64_t code)
+{
+    uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
+    double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
+    double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
+    return estimate <= 0 ? 0 : (uint64_t)estimate;
 }
 
 /* Largest layer k with u(k) <= code. With M = N + 1, 72(u~((N+1)/2) - code) equals
  * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
  * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
-/* Cube root of x >= 1 to ~1e-12: exponent/3 bit trick, then three Newton steps. The layer
- * search below only needs the estimate to within a layer, and libm's cbrt costs ~4x more. */
-static inline double cube_root(double x)
-{
-    uint64_t bits;
-    double y;
-    memcpy(&bits, &x, sizeof(bits));
-    bits = bits / 3 + 0x2A9F7893782DA1CEull;
-    memcpy(&y, &bits, sizeof(y));
-    for (int i = 0; i < 3; ++i) y -= (y * y * y - x) / (3 * y * y);
-    return y;
-}
-
-static uint64_t oss_find_layer(uint64_t n, uint64_t code)
+static uint64_t oss_find_layer(uint64_t n, uint64_t code, uint64_t* base)
 {
     uint64_t layers = (n + 1) / 2;
+    if (n < OSS_SMALL_N) {
+        uint64_t k = estimate_layer_small(n, code);
+        if (k >= layers) k = layers - 1;
+        uint64_t at = layer_base_small(n, k);
+        while (k > 0 && at > code) at = layer_base_small(n, --k);
+        for (uint64_t next; k + 1 < layers && (next = layer_base_small(n, k + 1)) <= code; ++k) at = next;
+        *base = at;
+        return k;
+    }
     double v;
-    if (n < OSS_SMALL_N) { /* everything below 2^63: no 128-bit conversions */
-        uint64_t m = n + 1;
-        v = (double)(int64_t)(4 * m * m * m + 6 * m * m + 16 - 72 * code);
-    } else { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
+    { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
         sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
         sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 4), sp_u128_mul_u64(m2, 6));
         v = sp_u128_to_double(sp_u128_sub(sp_u128_add_u64(cubic, 16), sp_u128_mul_u64(sp_u128_from(code), 72)));
     }
     double root = v > 2 ? sqrt(v * (v - 2)) : 0;
-    double c = n < OSS_SMALL_N ? cube_root(v - 1 + root) : cbrt(v - 1 + root);
+    double c = cbrt(v - 1 + root);
     if (c < 1) c = 1;
     double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
     uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (k >= layers) k = layers - 1;
-    if (n < OSS_SMALL_N) {
-        while (k + 1 < layers && layer_base_small(n, k + 1) <= code) ++k;
-        while (k > 0 && layer_base_small(n, k) > code) --k;
-        return k;
-    }
     while (k + 1 < layers && sp_oss_layer_base(n, k + 1) <= code) ++k;
     while (k > 0 && sp_oss_layer_base(n, k) > code) --k;
+    *base = sp_oss_layer_base(n, k);
     return k;
 }
 
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
 {
-    uint64_t layer = 0, row, rest = code, bottom = n;
+    uint64_t layer = 0, row, rest = code, bottom = n, base;
     if (k == 2) {
         q[1] = code;
         q[0] = 2 * (n - 1) - code;
         return;
     }
     if (k == 4) {
-        layer = oss_find_layer(n, code);
-        rest -= sp_oss_layer_base(n, layer); /* inlined small form for small N */
+        layer = oss_find_layer(n, code, &base);
+        rest -= base;
         bottom = n - 2 * layer;
     }
-    row = oss_find_row(bottom, rest);
-    uint64_t i = rest - sp_oss_row_base(bottom, row);
+    row = oss_find_row(bottom, rest, &base);
+    uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;
     q[1] = i + row + layer;
