@@ -1,9 +1,10 @@
 /*
  * skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512]: single-thread
  * throughput of every codec's batch encode and decode and of the tuple-table build, as ratios to
- * a memcpy of the 4 float weights (16 bytes a vertex) measured in the same run. Each figure is
- * the median of R runs (the machine may be shared); --isa caps the vector paths (the widest the
- * CPU has by default), so one binary measures every path.
+ * a memcpy of the 4 float weights (16 bytes a vertex) timed right before each repetition. Rates
+ * are medians of R repetitions, ratios the medians of the per-repetition ratios (the machine may
+ * be shared); --isa caps the vector paths (the widest the CPU has by default), so one binary
+ * measures every path.
  */
 #include <math.h>
 #include <stdio.h>
@@ -152,51 +153,73 @@ static void release(bench_buffers* b)
     free(b->tuple_index), free(b->lut), free(b->scratch), free(b->copy_src), free(b->copy_dst);
 }
 
+/* One timed memcpy of the weights' bytes (the baseline of every ratio, taken next to what it
+ * is compared with, so that a busy spell of the shared machine slows both). */
+static double time_memcpy(const bench_options* o, bench_buffers* b, int r)
+{
+    size_t bytes = o->count * INPUT_BYTES_PER_VERTEX;
+    double t0 = now_seconds();
+    memcpy(b->copy_dst, b->copy_src, bytes);
+    double t = now_seconds() - t0;
+    b->copy_src[r % 64] ^= b->copy_dst[bytes - 1 - r % 64]; /* keep the copy observable */
+    return t;
+}
+
+/* A measured rate and its ratio to memcpy: medians over the repetitions of each alone, and the
+ * median of the per-repetition ratios. */
+typedef struct bench_rate {
+    double per_s, ratio;
+} bench_rate;
+
+static bench_rate summarise(const bench_options* o, double* seconds, double* copy_seconds)
+{
+    double ratios[MAX_REPEATS];
+    for (int r = 0; r < o->repeats; ++r) ratios[r] = seconds[r] > 0 ? copy_seconds[r] / seconds[r] : 0;
+    bench_rate result = {rate(o->count, median(seconds, o->repeats)), median(ratios, o->repeats)};
+    return result;
+}
+
 static double memcpy_rate(const bench_options* o, bench_buffers* b)
 {
     double t[MAX_REPEATS];
-    size_t bytes = o->count * INPUT_BYTES_PER_VERTEX;
-    memcpy(b->copy_dst, b->copy_src, bytes); /* untimed: the first touch of the pages faults them in */
-    for (int r = 0; r < o->repeats; ++r) {
-        double t0 = now_seconds();
-        memcpy(b->copy_dst, b->copy_src, bytes);
-        t[r] = now_seconds() - t0;
-        b->copy_src[r] ^= b->copy_dst[bytes - 1 - r]; /* keep the copy observable */
-    }
+    memcpy(b->copy_dst, b->copy_src, o->count * INPUT_BYTES_PER_VERTEX); /* untimed: faults the pages in */
+    for (int r = 0; r < o->repeats; ++r) t[r] = time_memcpy(o, b, r);
     return rate(o->count, median(t, o->repeats));
 }
 
-static double lut_rate(const bench_options* o, bench_buffers* b, size_t* lut_size)
+static bench_rate lut_rate(const bench_options* o, bench_buffers* b, size_t* lut_size)
 {
-    double t[MAX_REPEATS];
+    double t[MAX_REPEATS], copy[MAX_REPEATS];
     sp_codec codec;
     sp_codec_from_bits(SP_METHOD_OSS, 4, 22, &codec);
     sp_encode_weights_batch(&codec, b->weights, o->count, b->codes, b->significant);
     for (int r = 0; r < o->repeats; ++r) {
+        copy[r] = time_memcpy(o, b, r);
         double t0 = now_seconds();
         sp_build_tuple_lut(b->joints, b->significant, o->count, 4, b->lut, lut_size, b->tuple_index, b->scratch,
                            b->scratch_size);
         t[r] = now_seconds() - t0;
     }
-    return rate(o->count, median(t, o->repeats));
+    return summarise(o, t, copy);
 }
 
-/* Median encode and decode rates of one codec over the narrowed K-wide weights. */
-static void codec_rates(const bench_options* o, bench_buffers* b, const sp_codec* codec, double* encode,
-                        double* decode)
+/* Encode and decode rates of one codec over the narrowed K-wide weights. */
+static void codec_rates(const bench_options* o, bench_buffers* b, const sp_codec* codec, bench_rate* encode,
+                        bench_rate* decode)
 {
-    double te[MAX_REPEATS], td[MAX_REPEATS];
+    double te[MAX_REPEATS], td[MAX_REPEATS], copy_e[MAX_REPEATS], copy_d[MAX_REPEATS];
     for (int r = 0; r < o->repeats; ++r) {
+        copy_e[r] = time_memcpy(o, b, r);
         double t0 = now_seconds();
         sp_encode_weights_batch_isa(codec, b->narrowed, o->count, b->codes, NULL, o->isa);
-        double t1 = now_seconds();
+        te[r] = now_seconds() - t0;
+        copy_d[r] = time_memcpy(o, b, r);
+        t0 = now_seconds();
         sp_decode_weights_batch_isa(codec, b->codes, o->count, b->decoded, NULL, o->isa);
-        double t2 = now_seconds();
-        te[r] = t1 - t0;
-        td[r] = t2 - t1;
+        td[r] = now_seconds() - t0;
     }
-    *encode = rate(o->count, median(te, o->repeats));
-    *decode = rate(o->count, median(td, o->repeats));
+    *encode = summarise(o, te, copy_e);
+    *decode = summarise(o, td, copy_d);
 }
 
 /* The K heaviest weights of each vertex, renormalised: what a K-influence skin holds. */
@@ -224,18 +247,19 @@ int skinpack_cmd_bench(int argc, char** argv)
     sp_isa cpu = sp_cpu_isa(), isa = cpu < o.isa ? cpu : o.isa;
     double copy = memcpy_rate(&o, &b);
     size_t lut_size = 0;
-    double lut = lut_rate(&o, &b, &lut_size);
+    bench_rate lut = lut_rate(&o, &b, &lut_size);
 
     if (o.json)
         printf("{\"vertices\": %zu, \"repeats\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
                "\"memcpy_bytes_per_vertex\": %d, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
                "\"lut_build_ratio\": %.3f, \"lut_size\": %zu, \"codecs\": [",
-               o.count, o.repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut, lut / copy, lut_size);
+               o.count, o.repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut.per_s, lut.ratio,
+               lut_size);
     else {
         printf("skinpack bench: %zu vertices, single thread, median of %d, vector path %s (CPU: %s)\n", o.count,
                o.repeats, isa_names[isa], isa_names[cpu]);
         printf("memcpy (16 B/vertex)  %8.1f M vertices/s\n", copy / 1e6);
-        printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut / 1e6, lut / copy,
+        printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut.per_s / 1e6, lut.ratio,
                lut_size);
         printf("%-6s %2s %4s  %10s %7s  %10s %7s\n", "method", "K", "bits", "encode M/s", "ratio", "decode M/s",
                "ratio");
@@ -247,7 +271,7 @@ int skinpack_cmd_bench(int argc, char** argv)
         for (int m = 0; m < SP_METHOD_COUNT; ++m)
             for (size_t i = 0; i < sizeof(budgets) / sizeof(budgets[0]); ++i) {
                 sp_codec codec;
-                double enc, dec;
+                bench_rate enc, dec;
                 if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
                 codec_rates(&o, &b, &codec, &enc, &dec);
                 int vector = m == SP_METHOD_OSS && isa > SP_ISA_SCALAR && sp_oss_batch_supported(&codec);
@@ -256,10 +280,10 @@ int skinpack_cmd_bench(int argc, char** argv)
                            "\"vector\": %s, \"encode_vertices_per_s\": %.0f, \"decode_vertices_per_s\": %.0f, "
                            "\"encode_ratio\": %.3f, \"decode_ratio\": %.3f}",
                            first ? "" : ", ", sp_method_name((sp_method)m), k, budgets[i], codec.bits,
-                           vector ? "true" : "false", enc, dec, enc / copy, dec / copy);
+                           vector ? "true" : "false", enc.per_s, dec.per_s, enc.ratio, dec.ratio);
                 else
                     printf("%-6s %2u %4u  %10.1f %6.3fx  %10.1f %6.3fx%s\n", sp_method_name((sp_method)m), k,
-                           codec.bits, enc / 1e6, enc / copy, dec / 1e6, dec / copy, vector ? "" : "  (scalar)");
+                           codec.bits, enc.per_s / 1e6, enc.ratio, dec.per_s / 1e6, dec.ratio, vector ? "" : "  (scalar)");
                 first = 0;
             }
     }
