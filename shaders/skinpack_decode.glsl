@@ -184,6 +184,67 @@ uvec2 sp_oss_layer_base64(uint n, uint k)
     return sp_u128_div_small(numerator, 9u).xy;
 }
 
+// ---- In-layer 32-bit forms (K = 4 wide codes while S(N) < 2^32, up to 46-bit codes) -------
+// Past 28 bits only the layer step needs 64 bits: every in-layer index is below S(N), so with
+// S(N) < 2^32 the row step runs on 32-bit values computed modulo 2^32 (the Authors' split).
+
+const uint SP_OSS_LAYER32_MAX_N = 113511u; // the largest N with S(N) < 2^32
+
+// sB(j) = jB - ceil((3j + 1)(j - 1) / 4) modulo 2^32: exact for every row, as sB(j) < 2^32;
+// the 34-bit product comes from umulExtended.
+uint sp_oss_row_base_in_layer32(uint b, uint j)
+{
+    if (j == 0u) return 0u;
+    uint high, low, carry;
+    umulExtended(3u * j + 1u, j - 1u, high, low);
+    low = uaddCarry(low, 3u, carry);
+    return j * b - ((low >> 2) | ((high + carry) << 30));
+}
+
+// S(B) and (B^2 + B + 1) mod 3 for S(B) < 2^32 in 32 bits: with B = 3t + e,
+// S(B) = 3t^2 + (2e + 1) t + e and the remainder is 0 for e = 1, else 1.
+uint sp_oss_triangle_count_in_layer32(uint b, out uint remainder)
+{
+    uint t = b / 3u, e = b - 3u * t;
+    remainder = e == 1u ? 0u : 1u;
+    return 3u * t * t + (2u * e + 1u) * t + e;
+}
+
+// The largest row j in [0, last] with sB(j) <= w (sp_oss_search32 on the in-layer forms).
+uint sp_oss_row_search_in_layer32(uint b, uint last, float estimate, uint w)
+{
+    uint x = estimate >= 0.0 ? uint(min(estimate, float(last))) : 0u; // NaN lands on 0
+    x = min(x, last);
+    uint low, high;
+    if (sp_oss_row_base_in_layer32(b, x) <= w) {
+        low = x;
+        high = last + 1u;
+        for (uint step = 1u; step <= last - low; step <<= 1) {
+            if (sp_oss_row_base_in_layer32(b, low + step) > w) {
+                high = low + step;
+                break;
+            }
+            low += step;
+        }
+    } else {
+        high = x;
+        low = 0u;
+        for (uint step = 1u; step < high; step <<= 1) {
+            if (sp_oss_row_base_in_layer32(b, high - step) <= w) {
+                low = high - step;
+                break;
+            }
+            high -= step;
+        }
+    }
+    while (high - low > 1u) {
+        uint middle = low + (high - low) / 2u;
+        if (sp_oss_row_base_in_layer32(b, middle) <= w) low = middle;
+        else high = middle;
+    }
+    return low;
+}
+
 // S(N) = floor((N^2 + N + 1) / 3), samples in a triangle with N bottom samples.
 uvec2 sp_oss_triangle_count64(uvec2 n)
 {
@@ -411,18 +472,29 @@ vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec
                     rest = sp_u64_sub(rest, sp_oss_layer_base64(n.x, layer.x));
                     bottom = sp_u64_sub(n, sp_u64_shift_left(layer, 1u));
                 }
-                uvec2 triangle_count = sp_oss_triangle_count64(bottom);
-                uint triangle_remainder = (bottom.x % 3u + bottom.y % 3u) % 3u; // 2^32 = 1 (mod 3)
-                triangle_remainder = (triangle_remainder * triangle_remainder + triangle_remainder + 1u) % 3u;
-                uvec2 row_count = sp_u128_div_small(uvec4(sp_u64_add(sp_u64_shift_left(bottom, 1u), uvec2(1u, 0u)), 0u, 0u), 3u).xy;
-                float estimate = sp_oss_row_estimate(sp_u64_to_float(bottom),
-                                                     sp_u64_to_float(sp_u64_sub(triangle_count, rest)),
-                                                     float(triangle_remainder));
-                row = sp_oss_search64(false, bottom, sp_u64_sub(row_count, uvec2(1u, 0u)), estimate, rest);
-                rest = sp_u64_sub(rest, sp_oss_row_base64(bottom, row));
-                q[3] = k == 4u ? layer : uvec2(0u);
-                q[2] = sp_u64_add(row, layer);
-                q[1] = sp_u64_add(rest, q[2]);
+                if (k == 4u && n.y == 0u && n.x <= SP_OSS_LAYER32_MAX_N) { // the row step in 32 bits
+                    uint remainder32, b32 = bottom.x;
+                    uint count32 = sp_oss_triangle_count_in_layer32(b32, remainder32);
+                    float estimate = sp_oss_row_estimate(float(b32), float(count32 - rest.x), float(remainder32));
+                    uint row32 = sp_oss_row_search_in_layer32(b32, (2u * b32 + 1u) / 3u - 1u, estimate, rest.x);
+                    uint i32 = rest.x - sp_oss_row_base_in_layer32(b32, row32);
+                    q[3] = layer;
+                    q[2] = uvec2(row32 + layer.x, 0u);
+                    q[1] = uvec2(i32 + row32 + layer.x, 0u);
+                } else {
+                    uvec2 triangle_count = sp_oss_triangle_count64(bottom);
+                    uint triangle_remainder = (bottom.x % 3u + bottom.y % 3u) % 3u; // 2^32 = 1 (mod 3)
+                    triangle_remainder = (triangle_remainder * triangle_remainder + triangle_remainder + 1u) % 3u;
+                    uvec2 row_count = sp_u128_div_small(uvec4(sp_u64_add(sp_u64_shift_left(bottom, 1u), uvec2(1u, 0u)), 0u, 0u), 3u).xy;
+                    float estimate = sp_oss_row_estimate(sp_u64_to_float(bottom),
+                                                         sp_u64_to_float(sp_u64_sub(triangle_count, rest)),
+                                                         float(triangle_remainder));
+                    row = sp_oss_search64(false, bottom, sp_u64_sub(row_count, uvec2(1u, 0u)), estimate, rest);
+                    rest = sp_u64_sub(rest, sp_oss_row_base64(bottom, row));
+                    q[3] = k == 4u ? layer : uvec2(0u);
+                    q[2] = sp_u64_add(row, layer);
+                    q[1] = sp_u64_add(rest, q[2]);
+                }
             }
         } else {
             uint first = method == SP_METHOD_FIXED ? 0u : 1u;
