@@ -186,9 +186,8 @@ uvec2 sp_oss_layer_base64(uint n, uint k)
 
 // ---- In-layer 32-bit forms (K = 4 wide codes while S(N) < 2^32, up to 46-bit codes) -------
 // Past 28 bits only the layer step needs 64 bits: every in-layer index is below S(N), so with
-// S(N) < 2^32 the row step runs on 32-bit values computed modulo 2^32 (the Authors' split).
-
-const uint SP_OSS_LAYER32_MAX_N = 113511u; // the largest N with S(N) < 2^32
+// S(N) < 2^32 (SP_GPU_CODEC_ROWS32) the row step runs on 32-bit values computed modulo 2^32
+// (the Authors' split).
 
 // sB(j) = jB - ceil((3j + 1)(j - 1) / 4) modulo 2^32: exact for every row, as sB(j) < 2^32;
 // the 34-bit product comes from umulExtended.
@@ -436,8 +435,10 @@ vec4 sp_decode_weights32(SpGpuCodec codec, uint code, out uvec4 q)
     return sp_grid_weights32(codec, q);
 }
 
-// Wide decoder: any code of up to 64 bits. q_low/q_high are the halves of q1..q4.
-vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec4 q_high)
+// Wide decoder: any code of up to 64 bits. q_low/q_high are the halves of q1..q4. rows32: take
+// the row step in 32 bits, which the caller has checked SP_GPU_CODEC_ROWS32 allows (a constant
+// in specialised shaders, so the other row step folds away).
+vec4 sp_decode_weights64_rows(SpGpuCodec codec, uvec2 code, bool rows32, out uvec4 q_low, out uvec4 q_high)
 {
     uint method = sp_codec_method(codec);
     uint k = sp_codec_influences(codec);
@@ -472,7 +473,7 @@ vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec
                     rest = sp_u64_sub(rest, sp_oss_layer_base64(n.x, layer.x));
                     bottom = sp_u64_sub(n, sp_u64_shift_left(layer, 1u));
                 }
-                if (k == 4u && n.y == 0u && n.x <= SP_OSS_LAYER32_MAX_N) { // the row step in 32 bits
+                if (rows32) { // K = 4 with S(N) < 2^32: the row step in 32 bits
                     uint remainder32, b32 = bottom.x;
                     uint count32 = sp_oss_triangle_count_in_layer32(b32, remainder32);
                     float estimate = sp_oss_row_estimate(float(b32), float(count32 - rest.x), float(remainder32));
@@ -511,6 +512,12 @@ vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec
     q_low = uvec4(q[0].x, q[1].x, q[2].x, q[3].x);
     q_high = uvec4(q[0].y, q[1].y, q[2].y, q[3].y);
     return w;
+}
+
+// The wide decoder with the cheapest row step exact for the codec.
+vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec4 q_high)
+{
+    return sp_decode_weights64_rows(codec, code, SP_GPU_CODEC_ROWS32(codec), q_low, q_high);
 }
 
 // Either decoder, whichever is exact for the codec (a uniform branch: all vertices agree).

@@ -4,7 +4,7 @@ CPU-only machine can measure (docs/benchmarks-gpu.md).
 
 usage: spirv_decode_cost.py SKIN_COMP_SPV
 For OSS (method 4) with K = 4 and each decoder (spec constants 1, 2, 3 of skin_common.glsl:
-method, influences, decoder 0 = narrow, 1 = wide), the module is specialised and optimised
+method, influences, decoder 0 = narrow, 1 = wide, 2 = wide with 32-bit rows), the module is specialised and optimised
 (spirv-opt --set-spec-const-default-value ... --freeze-spec-const -O), so the other paths fold
 away; counted are the instructions inside functions and, of those, the ALU ones (arithmetic,
 bit, compare, conversion, select, extended instructions). Static counts: loops count once.
@@ -48,7 +48,8 @@ def main():
         sys.exit(__doc__)
     print("| skin.comp, OSS K = 4 | instructions | ALU instructions |")
     print("|---|---|---|")
-    for decoder, name in ((0, "narrow (32-bit) decoder"), (1, "wide (64-bit) decoder")):
+    for decoder, name in ((0, "narrow (32-bit) decoder"), (1, "wide decoder, 64-bit row step"),
+                          (2, "wide decoder, 32-bit row step (S(N) < 2^32)")):
         total, alu = cost(sys.argv[1], decoder)
         print(f"| {name} | {total} | {alu} |")
 

@@ -783,8 +783,9 @@ static void test_mesh(harness* h, const char* path)
         gpu = gpu_skin(h, specialised_pipeline, &mesh, &gpu_codec, words, n * skin.words_per_vertex, lut_bytes,
                        lut_entries * skin.joint_bytes, NULL, 0);
         compare_positions(h, gpu, reference_decoded, n, tolerance,
-                          spec.decoder == SP_SPEC_DECODER_NARROW ? "  same, specialised 32-bit decoder"
-                                                                 : "  same, specialised 64-bit decoder");
+                          spec.decoder == SP_SPEC_DECODER_NARROW        ? "  same, specialised 32-bit decoder"
+                          : spec.decoder == SP_SPEC_DECODER_WIDE_ROWS32 ? "  same, specialised 64-bit layer / 32-bit row decoder"
+                                                                        : "  same, specialised 64-bit decoder");
         vkDestroyPipeline(h->ctx.device, specialised_pipeline, NULL);
 
         /* Quantisation effect vs the original weights, bounded per vertex by
