@@ -13,7 +13,9 @@
 //     code whose value, grid denominator and axis counts fit 32 bits.
 //   * wide: 64-bit values as uvec2 (x = low half, y = high half), 128-bit products as uvec4,
 //     built on uaddCarry/umulExtended. Needs no shaderInt64, so one code path runs everywhere;
-//     it is the Paper's "64-bit arithmetic" case (48-bit words, 38-bit weight codes).
+//     it is the Paper's "64-bit arithmetic" case (48-bit words, 38-bit weight codes). For OSS
+//     K = 4 with S(N) < 2^32 (codes of up to 46 bits, SP_GPU_CODEC_ROWS32) only the layer step
+//     runs in 64 bits; the row step runs on 32-bit in-layer values.
 // Both produce the exact integers q_i of format.md (x_i for Any), then float weights.
 
 #ifndef SKINPACK_DECODE_GLSL

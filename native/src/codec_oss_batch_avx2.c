@@ -8,15 +8,7 @@
 #include <immintrin.h>
 #include <string.h>
 
-/* With FMA3 enabled both compilers may fuse some multiplies and adds (GCC's gnu11 default
- * contracts across statements), which round differently from the scalar code: keep every
- * product and sum rounded on its own. Explicit FMAs appear only where the result is exact (the
- * OSS index arithmetic: integers and quarters below 2^50) or an estimate. */
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#else
-#pragma GCC optimize("fp-contract=off")
-#endif
+SP_FP_CONTRACT_OFF
 #define SIMD_FN SP_TARGET("avx2,fma")
 #define SIMD_NAME(name) sp_oss_##name##_avx2
 #define BLOCK 4

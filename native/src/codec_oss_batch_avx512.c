@@ -8,12 +8,7 @@
 #if SP_X86_SIMD
 #include <immintrin.h>
 
-/* avx512f implies fma: keep every product and sum rounded on its own (see the AVX2 file). */
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#else
-#pragma GCC optimize("fp-contract=off")
-#endif
+SP_FP_CONTRACT_OFF /* avx512f implies fma */
 #define SIMD_FN SP_TARGET("avx512f,avx512dq,avx512vl")
 #define SIMD_NAME(name) sp_oss_##name##_avx512
 #define BLOCK 8

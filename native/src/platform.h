@@ -30,6 +30,18 @@
 #define SP_UNROLL
 #endif
 
+/* From here to the end of the file, every product and sum rounds on its own: the vector paths
+ * must round as the scalar code does, and with FMA enabled both compilers would fuse some (GCC's
+ * gnu11 default contracts across statements). Explicit FMA intrinsics stay where they are exact
+ * or estimates. */
+#if defined(__clang__)
+#define SP_FP_CONTRACT_OFF _Pragma("STDC FP_CONTRACT OFF")
+#elif defined(__GNUC__)
+#define SP_FP_CONTRACT_OFF _Pragma("GCC optimize(\"fp-contract=off\")")
+#else
+#define SP_FP_CONTRACT_OFF
+#endif
+
 /*
  * Unsigned 128-bit integers for the OSS closed forms near 64-bit codes and the codec searches.
  * The compiler's type where it has one; elsewhere (MSVC) two 64-bit halves. Both expose the same
