@@ -273,6 +273,27 @@ float sp_oss_layer_estimate(float n, float count_minus_code)
     return (2.0 * n + 3.0 - (c + 1.0 / c)) / 4.0;
 }
 
+// Layer of a narrow K = 4 code from one cube root: t = c + 1/c with c = cbrt(x) and
+// x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code for code + 17/18 (M = N + 1; the vector paths'
+// shifted argument, native/src/codec_oss_simd.h), which puts every code strictly inside its
+// layer in exact arithmetic: no square roots, and float error moves the floor by at most one
+// layer near a boundary (a float32 emulation of every layer's first and last codes up to the
+// narrow limit: one), so one comparison each way fixes it. The fixes are loops, so any error
+// still ends on the exact layer. x = 144 (max_code - code) + x(max_code), the latter a small
+// number computed modulo 2^32.
+uint sp_oss_layer_narrow(uint n, uint max_code, uint code)
+{
+    uint m = n + 1u, last = (n + 1u) / 2u - 1u;
+    uint top = 8u * m * m * m + 12u * m * m - 106u - 144u * max_code; // x(max_code) >= 6
+    float x = 144.0 * float(max_code - code) + float(top);
+    float c = pow(x, 1.0 / 3.0);
+    float estimate = 0.25 * float(2u * n + 3u) - 0.25 * (c + 1.0 / c);
+    uint layer = estimate >= 0.0 ? min(uint(estimate), last) : 0u; // NaN lands on 0
+    while (layer > 0u && sp_oss_layer_base32(n, layer) > code) --layer;
+    while (layer < last && sp_oss_layer_base32(n, layer + 1u) <= code) ++layer;
+    return layer;
+}
+
 // The largest x in [0, last] with base(x) <= code. base(0) = 0 and base is increasing. Starts at
 // the float estimate and gallops (1, 2, 4, ... steps) to a bracket, then bisects: two base
 // evaluations when the estimate is right (the Paper's off-by-one check), O(log error) when the
@@ -403,9 +424,7 @@ vec4 sp_decode_weights32(SpGpuCodec codec, uint code, out uvec4 q)
         uint n = codec.n_scale.x;
         uint layer = 0u, row = 0u, rest = code, bottom = n;
         if (k == 4u) {
-            uint last_layer = (n + 1u) / 2u - 1u;
-            float estimate = sp_oss_layer_estimate(float(n), float(codec.max_code.x - code) + 1.0);
-            layer = sp_oss_search32(true, n, last_layer, estimate, code);
+            layer = sp_oss_layer_narrow(n, codec.max_code.x, code);
             rest -= sp_oss_layer_base32(n, layer);
             bottom = n - 2u * layer;
         }
