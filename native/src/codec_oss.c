@@ -107,7 +107,9 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w, uint64_t* base)
     double mirrored, apex;
     if (n < OSS_SMALL_N) {
         uint64_t two_n1 = 2 * n + 1;
-        mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w);
+        /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
+         * arithmetic, so the checks below take one step, not two */
+        mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
         apex = (double)two_n1;
     } else { /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
         sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
@@ -115,7 +117,6 @@ static uint64_t oss_find_row(uint64_t n, uint64_t w, uint64_t* base)
         mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
         apex = sp_u128_to_double(two_n1);
     }
-    if (n < OSS_SMALL_N) mirrored -= 10.5; /* for w + 7/8 (see row_estimate in codec_oss_simd.h): one step, not two */
     double estimate = (apex - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
