@@ -350,6 +350,10 @@ sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weight
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
     size_t first = sp_oss_encode_batch(codec, weights, vertex_count, codes, significant, widest); /* vector prefix */
+    if (codec->method == SP_METHOD_OSS && k >= 2 && k <= 4) {
+        sp_oss_encode_scalar(codec, weights, first, vertex_count, codes, significant);
+        return SP_OK;
+    }
 #define SP_ENCODE_LOOP(K)                                                                            \
     for (size_t v = first; v < vertex_count; ++v)                                                   \
         codes[v] = encode_one(codec, weights + v * (K), (K), significant ? significant + v : NULL);

@@ -21,12 +21,13 @@ void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint
  */
 SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
+    k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
     if (s < ((uint64_t)1 << 50)) {
-        double remainder[SP_MAX_INFLUENCES], sum = 0;
-        for (uint32_t i = 0; i < k; ++i) sum += weights[i];
+        double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, sum = 0;
+        SP_UNROLL for (uint32_t i = 0; i < k; ++i) sum += weights[i];
         double scale = (double)s / sum;
         int64_t deficit = (int64_t)s;
-        for (uint32_t i = 0; i < k; ++i) {
+        SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
             double x = weights[i] * scale;
             x = x > 0 ? x : 0;                 /* also maps NaN to 0 */
             x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
@@ -39,13 +40,13 @@ SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, ui
             /* rank[i]: components that win the bump before i (larger, or equal and lower);
              * each pair is compared once, a < b wins when its remainder is not smaller. */
             int64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            for (uint32_t a = 0; a < k; ++a)
-                for (uint32_t b = a + 1; b < k; ++b) {
+            SP_UNROLL for (uint32_t a = 0; a < k; ++a)
+                SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
                     int64_t a_wins = remainder[a] >= remainder[b];
                     rank[b] += a_wins;
                     rank[a] += 1 - a_wins;
                 }
-            for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
+            SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
             return;
         }
     }
@@ -58,7 +59,7 @@ SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, ui
 static inline uint8_t sp_grid_significant(const uint64_t* q, uint32_t k)
 {
     uint8_t count = 1;
-    for (uint32_t i = 1; i < k; ++i)
+    SP_UNROLL for (uint32_t i = 1; i < k; ++i)
         if (q[i] > 0) count = (uint8_t)(i + 1);
     return count;
 }
@@ -102,6 +103,10 @@ size_t sp_oss_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t
  * decode (codec_oss.c) of one vertex: what the batch loops and the vector lanes that cannot
  * prove themselves exact use. */
 uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant);
+/* The scalar OSS encode of vertices first..count-1 (K = 2..4; significant may be NULL), the
+ * rounding and index unrolled per K: what the batch encode runs after the vector prefix. */
+void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
+                          uint8_t* significant);
 void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights);
 
 /* Grid coordinates to weights, q[i] / s rounded once to float: every decoder's last step. */

@@ -12,10 +12,15 @@
 
 #include "codec_internal.h"
 
-/* Below this N every closed form fits in 64 bits (u(k) < 3N^3), so the fast path is exact. */
+/* Below these N the closed forms fit in 64 bits, so the 64-bit forms are exact: the row
+ * numerator 4jN + 2j + 1 < 3N^2 for rows j < (2N + 1)/3, the layer numerator below
+ * 3N^3/8 + N^3/16 + ... for layers k <= (N + 1)/2. */
 #define OSS_SMALL_N ((uint64_t)1 << 20)
+#define OSS_ROW64_N ((uint64_t)1 << 30)
+#define OSS_LAYER64_N ((uint64_t)1 << 21)
 
-/* 64-bit forms for N < OSS_SMALL_N, inlined into the encode and decode paths. */
+/* 64-bit forms for N below OSS_ROW64_N and OSS_LAYER64_N, inlined into the encode and decode
+ * paths. */
 static inline uint64_t row_base_small(uint64_t n, uint64_t j)
 {
     return (4 * j * n + 2 * j + 1 - 3 * j * j) / 4;
@@ -26,26 +31,35 @@ static inline uint64_t layer_base_small(uint64_t n, uint64_t k)
     return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9;
 }
 
-/* u(k) = floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9) in 128 bits, k <= (N + 1)/2 (so
- * N - 2k + 3 > 0; 4k^2 - 9k + 6 > 0 for every k). */
-static sp_u128 layer_numerator_over_9(uint64_t n, uint64_t k)
+/* floor(a / d) for a small constant d and a quotient below 2^64, without a 128-bit division:
+ * with a = h 2^64 + l and 2^64 = d Q + r, a / d = h Q + floor(l / d) + floor((h r + l mod d) / d). */
+SP_INLINE uint64_t u128_div_small(sp_u128 a, uint64_t d)
+{
+    uint64_t q = UINT64_MAX / d, r = UINT64_MAX % d + 1;
+    if (r == d) q += 1, r = 0;
+    uint64_t h = sp_u128_high(a), l = sp_u128_low(a);
+    return h * q + l / d + (h * r + l % d) / d;
+}
+
+/* 9 u(k) + (9 u(k)'s remainder): 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 in 128 bits,
+ * k <= (N + 1)/2 (so N - 2k + 3 > 0; 4k^2 - 9k + 6 > 0 for every k). */
+static sp_u128 layer_numerator(uint64_t n, uint64_t k)
 {
     sp_u128 nn = sp_u128_from(n), kk = sp_u128_from(k);
     sp_u128 width = sp_u128_sub(sp_u128_add_u64(nn, 3), sp_u128_mul_u64(kk, 2)); /* N - 2k + 3 */
     sp_u128 outer = sp_u128_mul(sp_u128_mul_u64(sp_u128_mul(nn, kk), 3), width);
     sp_u128 inner = sp_u128_add_u64(sp_u128_mul(sp_u128_sub(sp_u128_mul_u64(kk, 4), sp_u128_from(9)), kk), 6);
-    sp_u128 numerator = sp_u128_add_u64(sp_u128_add(outer, sp_u128_mul(kk, inner)), 2);
-    return sp_u128_div_u64(numerator, 9);
+    return sp_u128_add_u64(sp_u128_add(outer, sp_u128_mul(kk, inner)), 2);
 }
 
 uint64_t sp_oss_row_base(uint64_t n, uint64_t j)
 {
     /* floor((-3j^2 + 2j + 4jN + 1) / 4); the numerator is positive for rows inside the triangle. */
-    if (n < OSS_SMALL_N && j < OSS_SMALL_N) return row_base_small(n, j);
+    if (n < OSS_ROW64_N && j < OSS_ROW64_N) return row_base_small(n, j);
     /* (4N + 2 - 3j) j + 1, positive inside the triangle */
     sp_u128 slope = sp_u128_sub(sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 4), 2), sp_u128_mul_u64(sp_u128_from(j), 3));
     sp_u128 numerator = sp_u128_add_u64(sp_u128_mul_u64(slope, j), 1);
-    return sp_u128_low(sp_u128_div_u64(numerator, 4));
+    return u128_div_small(numerator, 4);
 }
 
 uint64_t sp_oss_triangle_count(uint64_t n)
@@ -56,8 +70,8 @@ uint64_t sp_oss_triangle_count(uint64_t n)
 uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
-    if (n < OSS_SMALL_N) return layer_base_small(n, k);
-    return sp_u128_low(layer_numerator_over_9(n, k));
+    if (n < OSS_LAYER64_N) return layer_base_small(n, k);
+    return u128_div_small(layer_numerator(n, k), 9);
 }
 
 uint64_t sp_oss_tetrahedron_count(uint64_t n)
@@ -75,25 +89,55 @@ sp_u128 sp_oss_code_count(uint64_t n, uint32_t k)
         return sp_u128_div_u64(sp_u128_add_u64(sp_u128_mul(nn, sp_u128_add_u64(nn, 1)), 1), 3);
     }
     case 4: /* u((N+1)/2), whose numerator fits 128 bits for N < 2^42, far past 64-bit codes */
-        return n < ((uint64_t)1 << 42) ? layer_numerator_over_9(n, n / 2 + (n & 1)) : sp_u128_from(0);
+        return n < ((uint64_t)1 << 42) ? sp_u128_div_u64(layer_numerator(n, n / 2 + (n & 1)), 9) : sp_u128_from(0);
     default: return sp_u128_from(0);
+    }
+}
+
+/* The index of grid point q, inlined into the batch encoder below with a constant k: the 64-bit
+ * closed forms wherever they are exact, the 128-bit ones (no 128-bit division) past them. */
+SP_INLINE uint64_t oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
+{
+    switch (k) {
+    case 2: return q[1];
+    case 3: return (n < OSS_ROW64_N ? row_base_small(n, q[2]) : sp_oss_row_base(n, q[2])) + (q[1] - q[2]);
+    case 4: {
+        uint64_t layer = q[3], bottom = n - 2 * layer, row = q[2] - q[3];
+        uint64_t layer_base = n < OSS_LAYER64_N ? layer_base_small(n, layer) : sp_oss_layer_base(n, layer);
+        uint64_t row_base = n < OSS_ROW64_N ? row_base_small(bottom, row) : sp_oss_row_base(bottom, row);
+        return layer_base + row_base + (q[1] - q[2]);
+    }
+    default: return 0;
     }
 }
 
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 {
-    if (n < OSS_SMALL_N && k == 4) {
-        uint64_t layer = q[3];
-        return layer_base_small(n, layer) + row_base_small(n - 2 * layer, q[2] - q[3]) + (q[1] - q[2]);
+    return oss_pack(n, k, q);
+}
+
+/* One vertex after another with k constant, so the rounding and the index unroll into
+ * straight-line code with q in registers. */
+SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                              uint64_t* codes, uint8_t* significant, uint32_t k)
+{
+    uint64_t n = codec->n, scale = codec->scale;
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+        sp_grid_quantize(weights + v * k, k, scale, q);
+        if (significant) significant[v] = sp_grid_significant(q, k);
+        codes[v] = oss_pack(n, k, q);
     }
-    switch (k) {
-    case 2: return q[1];
-    case 3: return sp_oss_row_base(n, q[2]) + (q[1] - q[2]);
-    case 4: {
-        uint64_t layer = q[3];
-        return sp_oss_layer_base(n, layer) + sp_oss_row_base(n - 2 * layer, q[2] - q[3]) + (q[1] - q[2]);
-    }
-    default: return 0;
+}
+
+void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
+                          uint8_t* significant)
+{
+    switch (codec->influences) {
+    case 2: oss_encode_run(codec, weights, first, count, codes, significant, 2); break;
+    case 3: oss_encode_run(codec, weights, first, count, codes, significant, 3); break;
+    case 4: oss_encode_run(codec, weights, first, count, codes, significant, 4); break;
+    default: break;
     }
 }
 
