@@ -5,6 +5,9 @@
 #include "skinpack.h"
 
 #include "cpu_features.h"
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+#include <emmintrin.h> /* sp_positive_or_zero */
+#endif
 #include "platform.h" /* SP_INLINE, sp_u128 (the OSS closed forms overflow 64 bits near 64-bit codes) */
 
 /* Float rounding of the input weights and of the decoded floats, added to every bound. */
@@ -12,6 +15,18 @@
 
 /* Largest-remainder rounding for any grid and any deficit (the slow, general path). */
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q);
+
+/* x > 0 ? x : 0 (NaN and -0 to +0) without a branch: zero weights are common and in no
+ * predictable order, and compilers keep the branch for the NaN semantics. MAXSD returns its
+ * second operand unless the first is greater, which is exactly this. */
+SP_INLINE double sp_positive_or_zero(double x)
+{
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+    return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(x), _mm_setzero_pd()));
+#else
+    return x > 0 ? x : 0;
+#endif
+}
 
 /*
  * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s.
@@ -29,7 +44,7 @@ SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, ui
         int64_t deficit = (int64_t)s;
         SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
             double x = weights[i] * scale;
-            x = x > 0 ? x : 0;                 /* also maps NaN to 0 */
+            x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
             x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
             int64_t f = (int64_t)x;
             q[i] = (uint64_t)f;
