@@ -373,6 +373,8 @@ sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* cod
     if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
     size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights, widest); /* vector prefix */
+    if (codec->method == SP_METHOD_OSS && k >= 2 && k <= 4)
+        first = sp_oss_decode_scalar(codec, codes, first, vertex_count, weights); /* stops at an invalid code */
     for (size_t v = first; v < vertex_count; ++v) {
         if (!decode_valid(codec, codes[v], weights + v * k)) {
             if (error_vertex) *error_vertex = v;

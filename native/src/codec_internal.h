@@ -122,6 +122,9 @@ uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t*
  * rounding and index unrolled per K: what the batch encode runs after the vector prefix. */
 void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
                           uint8_t* significant);
+/* The scalar OSS decode of codes first..count-1 (K = 2..4), inlined per K: returns the index of
+ * the first code past the codec's range (weights untouched from there), count if none. */
+size_t sp_oss_decode_scalar(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count, float* weights);
 void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights);
 
 /* Grid coordinates to weights, q[i] / s rounded once to float: every decoder's last step. */

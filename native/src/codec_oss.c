@@ -144,33 +144,36 @@ void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t fi
 /* Largest row j with s_N(j) <= w. Estimate from the mirrored square root:
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
- * relevant root is the one left of the apex.) */
-static uint64_t oss_find_row(uint64_t n, uint64_t w, uint64_t* base)
+ * relevant root is the one left of the apex.) For N < OSS_SMALL_N, inlined into the batch
+ * decoder (everything but w is the same for every code of a layer size). */
+SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
 {
-    uint64_t rows = (2 * n + 1) / 3;
-    double mirrored, apex;
-    if (n < OSS_SMALL_N) {
-        uint64_t two_n1 = 2 * n + 1;
-        /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
-         * arithmetic, so the checks below take one step, not two */
-        mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
-        apex = (double)two_n1;
-    } else { /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
-        sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
-        sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
-        mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
-        apex = sp_u128_to_double(two_n1);
-    }
-    double estimate = (apex - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1;
+    /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
+     * arithmetic, so the checks below take one step, not two */
+    double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
+    double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
-    if (n < OSS_SMALL_N) { /* the estimate is the row but for rounding: one check each way */
-        uint64_t at = row_base_small(n, j);
-        while (j > 0 && at > w) at = row_base_small(n, --j);
-        for (uint64_t next; j + 1 < rows && (next = row_base_small(n, j + 1)) <= w; ++j) at = next;
-        *base = at;
-        return j;
-    }
+    /* the estimate is the row but for rounding: one check each way */
+    uint64_t at = row_base_small(n, j);
+    while (j > 0 && at > w) at = row_base_small(n, --j);
+    for (uint64_t next; j + 1 < rows && (next = row_base_small(n, j + 1)) <= w; ++j) at = next;
+    *base = at;
+    return j;
+}
+
+/* The same for N >= OSS_SMALL_N, with the root's argument in 128 bits. */
+static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
+{
+    uint64_t rows = (2 * n + 1) / 3;
+    /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
+    sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
+    sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
+    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
+    double estimate = (sp_u128_to_double(two_n1) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
+    if (j >= rows) j = rows - 1;
     while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
     while (j > 0 && sp_oss_row_base(n, j) > w) --j;
     *base = sp_oss_row_base(n, j);
@@ -196,33 +199,31 @@ static inline double cube_root_sum(double x)
     return (c + z) + rd * (c * (2.0 / 3.0) + z * (1.0 / 3.0));
 }
 
-/* The layer estimate of the vector paths for N < OSS_SMALL_N: (2N + 3 - t) / 4 with
- * t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code for code + 17/18, which
- * puts every code strictly inside its layer (see codec_oss_simd.h): one check each way, no
- * square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
-static uint64_t estimate_layer_small(uint64_t n, uint64_t code)
+/* Largest layer k with u(k) <= code for N < OSS_SMALL_N. The estimate of the vector paths:
+ * (2N + 3 - t) / 4 with t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code
+ * for code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one
+ * check each way, no square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
+SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
 {
+    uint64_t layers = (n + 1) / 2;
     uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
     double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
     double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
-    return estimate <= 0 ? 0 : (uint64_t)estimate;
+    uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
+    if (k >= layers) k = layers - 1;
+    uint64_t at = layer_base_small(n, k);
+    while (k > 0 && at > code) at = layer_base_small(n, --k);
+    for (uint64_t next; k + 1 < layers && (next = layer_base_small(n, k + 1)) <= code; ++k) at = next;
+    *base = at;
+    return k;
 }
 
-/* Largest layer k with u(k) <= code. With M = N + 1, 72(u~((N+1)/2) - code) equals
+/* The same for N >= OSS_SMALL_N. With M = N + 1, 72(u~((N+1)/2) - code) equals
  * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
  * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
-static uint64_t oss_find_layer(uint64_t n, uint64_t code, uint64_t* base)
+static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
 {
     uint64_t layers = (n + 1) / 2;
-    if (n < OSS_SMALL_N) {
-        uint64_t k = estimate_layer_small(n, code);
-        if (k >= layers) k = layers - 1;
-        uint64_t at = layer_base_small(n, k);
-        while (k > 0 && at > code) at = layer_base_small(n, --k);
-        for (uint64_t next; k + 1 < layers && (next = layer_base_small(n, k + 1)) <= code; ++k) at = next;
-        *base = at;
-        return k;
-    }
     double v;
     { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
         sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
@@ -241,7 +242,8 @@ static uint64_t oss_find_layer(uint64_t n, uint64_t code, uint64_t* base)
     return k;
 }
 
-void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+/* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
+SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
 {
     uint64_t layer = 0, row, rest = code, bottom = n, base;
     if (k == 2) {
@@ -250,16 +252,46 @@ void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
         return;
     }
     if (k == 4) {
-        layer = oss_find_layer(n, code, &base);
+        layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
         rest -= base;
         bottom = n - 2 * layer;
     }
-    row = oss_find_row(bottom, rest, &base);
+    row = bottom < OSS_SMALL_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
     uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;
     q[1] = i + row + layer;
     q[0] = 2 * (n - 1) - q[1] - q[2] - (k == 4 ? q[3] : 0);
+}
+
+void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+{
+    oss_unpack(n, k, code, q);
+}
+
+/* Decodes codes first..count-1 with k constant; stops at a code past the codec's range. */
+SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count,
+                                float* weights, uint32_t k)
+{
+    uint64_t n = codec->n, max_code = codec->max_code;
+    double inverse = 1.0 / (double)codec->scale; /* as sp_grid_to_weights */
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+        if (codes[v] > max_code) return v;
+        oss_unpack(n, k, codes[v], q);
+        for (uint32_t i = 0; i < k; ++i) weights[v * k + i] = (float)((double)q[i] * inverse);
+    }
+    return count;
+}
+
+size_t sp_oss_decode_scalar(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count, float* weights)
+{
+    switch (codec->influences) {
+    case 2: return oss_decode_run(codec, codes, first, count, weights, 2);
+    case 3: return oss_decode_run(codec, codes, first, count, weights, 3);
+    case 4: return oss_decode_run(codec, codes, first, count, weights, 4);
+    default: return first;
+    }
 }
 
 uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
