@@ -51,12 +51,15 @@ size_t sp_tuple_lut_scratch_bound(size_t vertex_count, size_t influences)
     return scratch_bytes(vertex_count, influences);
 }
 
-/* The first `length` joints as one key (K <= 4 joints of 16 bits). */
-static inline uint64_t prefix_key(const uint16_t* joints, size_t length)
+/* The first `length` joints as one key (K <= 4 joints of 16 bits): all K read without a loop
+ * over the length, the slots past it masked off. */
+static inline uint64_t prefix_key(const uint16_t* joints, size_t k, size_t length)
 {
-    uint64_t key = 0;
-    for (size_t i = 0; i < length; ++i) key |= (uint64_t)joints[i] << (16 * i);
-    return key;
+    uint64_t key = joints[0];
+    if (k > 1) key |= (uint64_t)joints[1] << 16;
+    if (k > 2) key |= (uint64_t)joints[2] << 32;
+    if (k > 3) key |= (uint64_t)joints[3] << 48;
+    return length >= 4 ? key : key & ((((uint64_t)1) << (16 * length)) - 1);
 }
 
 static inline size_t slot_of(const lut_builder* b, uint64_t key, size_t length)
@@ -71,7 +74,7 @@ static size_t find_slot(const lut_builder* b, uint64_t key, size_t length)
     for (size_t at = slot_of(b, key, length);; at = (at + 1) & mask) {
         uint32_t entry = b->slots[at];
         if (entry == 0) return at;
-        if (b->lengths[at] == length && prefix_key(b->lut + (size_t)(entry - 1) * b->k, length) == key) return at;
+        if (b->lengths[at] == length && prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length) == key) return at;
     }
 }
 
@@ -101,7 +104,7 @@ static void grow(lut_builder* b)
         uint32_t entry = old_slots[i];
         if (entry == 0) continue;
         size_t length = old_lengths[i], mask = b->capacity - 1;
-        size_t at = slot_of(b, prefix_key(b->lut + (size_t)(entry - 1) * b->k, length), length);
+        size_t at = slot_of(b, prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length), length);
         while (b->slots[at]) at = (at + 1) & mask;
         b->slots[at] = entry;
         b->lengths[at] = (uint8_t)length;
@@ -115,7 +118,7 @@ static uint32_t add_entry(lut_builder* b, const uint16_t* joints, size_t first_l
     memcpy(b->lut + (size_t)entry * b->k, joints, b->k * sizeof(uint16_t));
     for (size_t length = first_length; length <= b->k; ++length) {
         if (2 * (b->used + 1) > b->capacity && b->capacity < b->full) grow(b);
-        size_t at = find_slot(b, prefix_key(joints, length), length);
+        size_t at = find_slot(b, prefix_key(joints, b->k, length), length);
         if (b->slots[at] == 0) {
             b->slots[at] = entry + 1;
             b->lengths[at] = (uint8_t)length;
@@ -130,7 +133,7 @@ static uint32_t add_entry(lut_builder* b, const uint16_t* joints, size_t first_l
 static inline void index_vertex(lut_builder* b, const uint16_t* tuple, size_t length, size_t register_from,
                                 uint64_t* last_key, uint32_t* last_entry, uint32_t* index)
 {
-    uint64_t key = prefix_key(tuple, length);
+    uint64_t key = prefix_key(tuple, b->k, length);
     if (key != *last_key || *last_entry == UINT32_MAX) {
         size_t at = find_slot(b, key, length);
         *last_entry = b->slots[at] ? b->slots[at] - 1 : add_entry(b, tuple, register_from);
@@ -146,15 +149,22 @@ static inline void index_vertex(lut_builder* b, const uint16_t* tuple, size_t le
 static int bucket_by_length(const uint8_t* significant, size_t vertex_count, size_t k, uint32_t* order,
                             size_t* start)
 {
-    size_t count[SP_MAX_INFLUENCES + 1] = {0};
-    uint8_t most = 0;
-    for (size_t v = 0; v < vertex_count; ++v) most = significant[v] > most ? significant[v] : most;
-    if (most > k) return 0;
-    for (size_t length = 2; length <= k; ++length) { /* branch-free counts the compiler vectorises */
-        size_t n = 0;
-        for (size_t v = 0; v < vertex_count; ++v) n += significant[v] == length;
-        count[length] = n;
+    size_t count[8] = {0};
+    unsigned seen = 0;
+    /* one branch-free pass: eight 8-bit counters in one word (by value & 7), emptied every 255
+     * vertices; values of 8 and more show in the OR of all */
+    for (size_t first = 0; first < vertex_count; first += 255) {
+        size_t end = vertex_count - first < 255 ? vertex_count : first + 255;
+        uint64_t packed = 0;
+        for (size_t v = first; v < end; ++v) {
+            packed += (uint64_t)1 << ((significant[v] & 7) * 8);
+            seen |= significant[v];
+        }
+        for (size_t value = 0; value < 8; ++value) count[value] += (size_t)(packed >> (8 * value)) & 255;
     }
+    if (seen > 7) return 0;
+    for (size_t value = k + 1; value < 8; ++value)
+        if (count[value]) return 0;
     count[1] = vertex_count;
     for (size_t length = 2; length <= k; ++length) count[1] -= count[length];
     start[k] = 0; /* the longest prefixes first */
