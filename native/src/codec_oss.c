@@ -141,6 +141,20 @@ void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t fi
     }
 }
 
+/* The largest index i < count with base_of(n, i) <= w, from an estimate that is it but for
+ * rounding: clamped, then one check each way (inlined with base_of, so no indirect call). */
+SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, uint64_t w,
+                                   uint64_t (*base_of)(uint64_t, uint64_t), uint64_t* base)
+{
+    uint64_t i = estimate <= 0 ? 0 : (uint64_t)estimate;
+    if (i >= count) i = count - 1;
+    uint64_t at = base_of(n, i);
+    while (i > 0 && at > w) at = base_of(n, --i);
+    for (uint64_t next; i + 1 < count && (next = base_of(n, i + 1)) <= w; ++i) at = next;
+    *base = at;
+    return i;
+}
+
 /* Largest row j with s_N(j) <= w. Estimate from the mirrored square root:
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
@@ -153,14 +167,7 @@ SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
      * arithmetic, so the checks below take one step, not two */
     double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
     double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (j >= rows) j = rows - 1;
-    /* the estimate is the row but for rounding: one check each way */
-    uint64_t at = row_base_small(n, j);
-    while (j > 0 && at > w) at = row_base_small(n, --j);
-    for (uint64_t next; j + 1 < rows && (next = row_base_small(n, j + 1)) <= w; ++j) at = next;
-    *base = at;
-    return j;
+    return settle_estimate(estimate, rows, n, w, row_base_small, base);
 }
 
 /* The same for N >= OSS_SMALL_N, with the root's argument in 128 bits. */
@@ -209,13 +216,7 @@ SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
     uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
     double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
     double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
-    uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (k >= layers) k = layers - 1;
-    uint64_t at = layer_base_small(n, k);
-    while (k > 0 && at > code) at = layer_base_small(n, --k);
-    for (uint64_t next; k + 1 < layers && (next = layer_base_small(n, k + 1)) <= code; ++k) at = next;
-    *base = at;
-    return k;
+    return settle_estimate(estimate, layers, n, code, layer_base_small, base);
 }
 
 /* The same for N >= OSS_SMALL_N. With M = N + 1, 72(u~((N+1)/2) - code) equals
