@@ -6,7 +6,7 @@
 #include "codec_internal.h"
 
 /* Slot order by descending remainder, ties to the lower slot (stable insertion sort). */
-static void order_by_remainder(const double* remainder, uint32_t k, uint32_t* order)
+SP_INLINE void order_by_remainder(const double* remainder, uint32_t k, uint32_t* order)
 {
     for (uint32_t i = 0; i < k; ++i) {
         uint32_t j = i;
@@ -18,24 +18,20 @@ static void order_by_remainder(const double* remainder, uint32_t k, uint32_t* or
     }
 }
 
-/* floor(x) for 0 <= x, clamped to [0, limit]; long double keeps all 64 bits of large grids. */
-static uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
+/* floor(x) for 0 <= x, clamped to [0, limit] (NaN to 0); long double keeps all 64 bits of large
+ * grids. Selects, not branches: zero weights come in no predictable order. */
+SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
 {
-    if (!(x > 0)) {
-        *remainder = 0;
-        return 0;
-    }
-    if (x >= (long double)limit) {
-        *remainder = 0;
-        return limit;
-    }
+    long double top = (long double)limit;
+    x = x > 0 ? x : 0;
+    x = x < top ? x : top;
     uint64_t f = (uint64_t)x;
     *remainder = (double)(x - (long double)f);
     return f;
 }
 
 /* General rounding: any grid size, any deficit (also the rare wrap-around of huge grids). */
-static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
+SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     double remainder[SP_MAX_INFLUENCES];
     uint32_t order[SP_MAX_INFLUENCES];
@@ -75,7 +71,9 @@ static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint6
 
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
-    quantize_general(weights, k, s, q);
+    /* K = 2 with a constant k: what OSS codes of 51..64 bits (grids past 2^50) take per vertex */
+    if (k == 2) quantize_general(weights, 2, s, q);
+    else quantize_general(weights, k, s, q);
 }
 
 /* Stored components: Fixed stores q[0..k-1], Cube and POT q[1..k-1]. */
