@@ -40,8 +40,9 @@ SpGpuCodec skin_codec()
 vec4 skin_decode_weights(SpGpuCodec c, uvec2 code)
 {
     bool narrow = SPEC_DECODER == SP_SPEC_RUNTIME ? sp_codec_is_narrow(c) : SPEC_DECODER == SP_SPEC_DECODER_NARROW;
+    bool rows32 = SPEC_DECODER == SP_SPEC_RUNTIME ? SP_GPU_CODEC_ROWS32(c) : SPEC_DECODER == SP_SPEC_DECODER_WIDE_ROWS32;
     uvec4 q_low, q_high;
-    return narrow ? sp_decode_weights32(c, code.x, q_low) : sp_decode_weights64(c, code, q_low, q_high);
+    return narrow ? sp_decode_weights32(c, code.x, q_low) : sp_decode_weights64_rows(c, code, rows32, q_low, q_high);
 }
 
 uvec4 skin_unpack_joints8(uint word)

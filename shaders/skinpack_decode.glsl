@@ -13,7 +13,9 @@
 //     code whose value, grid denominator and axis counts fit 32 bits.
 //   * wide: 64-bit values as uvec2 (x = low half, y = high half), 128-bit products as uvec4,
 //     built on uaddCarry/umulExtended. Needs no shaderInt64, so one code path runs everywhere;
-//     it is the Paper's "64-bit arithmetic" case (48-bit words, 38-bit weight codes).
+//     it is the Paper's "64-bit arithmetic" case (48-bit words, 38-bit weight codes). For OSS
+//     K = 4 with S(N) < 2^32 (codes of up to 46 bits, SP_GPU_CODEC_ROWS32) only the layer step
+//     runs in 64 bits; the row step runs on 32-bit in-layer values.
 // Both produce the exact integers q_i of format.md (x_i for Any), then float weights.
 
 #ifndef SKINPACK_DECODE_GLSL
@@ -184,6 +186,66 @@ uvec2 sp_oss_layer_base64(uint n, uint k)
     return sp_u128_div_small(numerator, 9u).xy;
 }
 
+// ---- In-layer 32-bit forms (K = 4 wide codes while S(N) < 2^32, up to 46-bit codes) -------
+// Past 28 bits only the layer step needs 64 bits: every in-layer index is below S(N), so with
+// S(N) < 2^32 (SP_GPU_CODEC_ROWS32) the row step runs on 32-bit values computed modulo 2^32
+// (the Authors' split).
+
+// sB(j) = jB - ceil((3j + 1)(j - 1) / 4) modulo 2^32: exact for every row, as sB(j) < 2^32;
+// the 34-bit product comes from umulExtended.
+uint sp_oss_row_base_in_layer32(uint b, uint j)
+{
+    if (j == 0u) return 0u;
+    uint high, low, carry;
+    umulExtended(3u * j + 1u, j - 1u, high, low);
+    low = uaddCarry(low, 3u, carry);
+    return j * b - ((low >> 2) | ((high + carry) << 30));
+}
+
+// S(B) and (B^2 + B + 1) mod 3 for S(B) < 2^32 in 32 bits: with B = 3t + e,
+// S(B) = 3t^2 + (2e + 1) t + e and the remainder is 0 for e = 1, else 1.
+uint sp_oss_triangle_count_in_layer32(uint b, out uint remainder)
+{
+    uint t = b / 3u, e = b - 3u * t;
+    remainder = e == 1u ? 0u : 1u;
+    return 3u * t * t + (2u * e + 1u) * t + e;
+}
+
+// The largest row j in [0, last] with sB(j) <= w (sp_oss_search32 on the in-layer forms).
+uint sp_oss_row_search_in_layer32(uint b, uint last, float estimate, uint w)
+{
+    uint x = estimate >= 0.0 ? uint(min(estimate, float(last))) : 0u; // NaN lands on 0
+    x = min(x, last);
+    uint low, high;
+    if (sp_oss_row_base_in_layer32(b, x) <= w) {
+        low = x;
+        high = last + 1u;
+        for (uint step = 1u; step <= last - low; step <<= 1) {
+            if (sp_oss_row_base_in_layer32(b, low + step) > w) {
+                high = low + step;
+                break;
+            }
+            low += step;
+        }
+    } else {
+        high = x;
+        low = 0u;
+        for (uint step = 1u; step < high; step <<= 1) {
+            if (sp_oss_row_base_in_layer32(b, high - step) <= w) {
+                low = high - step;
+                break;
+            }
+            high -= step;
+        }
+    }
+    while (high - low > 1u) {
+        uint middle = low + (high - low) / 2u;
+        if (sp_oss_row_base_in_layer32(b, middle) <= w) low = middle;
+        else high = middle;
+    }
+    return low;
+}
+
 // S(N) = floor((N^2 + N + 1) / 3), samples in a triangle with N bottom samples.
 uvec2 sp_oss_triangle_count64(uvec2 n)
 {
@@ -209,6 +271,27 @@ float sp_oss_layer_estimate(float n, float count_minus_code)
     float v = 72.0 * count_minus_code + 39.0;
     float c = pow(v - 1.0 + sqrt(v) * sqrt(v - 2.0), 1.0 / 3.0);
     return (2.0 * n + 3.0 - (c + 1.0 / c)) / 4.0;
+}
+
+// Layer of a narrow K = 4 code from one cube root: t = c + 1/c with c = cbrt(x) and
+// x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code for code + 17/18 (M = N + 1; the vector paths'
+// shifted argument, native/src/codec_oss_simd.h), which puts every code strictly inside its
+// layer in exact arithmetic: no square roots, and float error moves the floor by at most one
+// layer near a boundary (a float32 emulation of every layer's first and last codes up to the
+// narrow limit: one), so one comparison each way fixes it. The fixes are loops, so any error
+// still ends on the exact layer. x = 144 (max_code - code) + x(max_code), the latter a small
+// number computed modulo 2^32.
+uint sp_oss_layer_narrow(uint n, uint max_code, uint code)
+{
+    uint m = n + 1u, last = (n + 1u) / 2u - 1u;
+    uint top = 8u * m * m * m + 12u * m * m - 106u - 144u * max_code; // x(max_code) >= 6
+    float x = 144.0 * float(max_code - code) + float(top);
+    float c = pow(x, 1.0 / 3.0);
+    float estimate = 0.25 * float(2u * n + 3u) - 0.25 * (c + 1.0 / c);
+    uint layer = estimate >= 0.0 ? min(uint(estimate), last) : 0u; // NaN lands on 0
+    while (layer > 0u && sp_oss_layer_base32(n, layer) > code) --layer;
+    while (layer < last && sp_oss_layer_base32(n, layer + 1u) <= code) ++layer;
+    return layer;
 }
 
 // The largest x in [0, last] with base(x) <= code. base(0) = 0 and base is increasing. Starts at
@@ -341,9 +424,7 @@ vec4 sp_decode_weights32(SpGpuCodec codec, uint code, out uvec4 q)
         uint n = codec.n_scale.x;
         uint layer = 0u, row = 0u, rest = code, bottom = n;
         if (k == 4u) {
-            uint last_layer = (n + 1u) / 2u - 1u;
-            float estimate = sp_oss_layer_estimate(float(n), float(codec.max_code.x - code) + 1.0);
-            layer = sp_oss_search32(true, n, last_layer, estimate, code);
+            layer = sp_oss_layer_narrow(n, codec.max_code.x, code);
             rest -= sp_oss_layer_base32(n, layer);
             bottom = n - 2u * layer;
         }
@@ -375,8 +456,10 @@ vec4 sp_decode_weights32(SpGpuCodec codec, uint code, out uvec4 q)
     return sp_grid_weights32(codec, q);
 }
 
-// Wide decoder: any code of up to 64 bits. q_low/q_high are the halves of q1..q4.
-vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec4 q_high)
+// Wide decoder: any code of up to 64 bits. q_low/q_high are the halves of q1..q4. rows32: take
+// the row step in 32 bits, which the caller has checked SP_GPU_CODEC_ROWS32 allows (a constant
+// in specialised shaders, so the other row step folds away).
+vec4 sp_decode_weights64_rows(SpGpuCodec codec, uvec2 code, bool rows32, out uvec4 q_low, out uvec4 q_high)
 {
     uint method = sp_codec_method(codec);
     uint k = sp_codec_influences(codec);
@@ -411,18 +494,29 @@ vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec
                     rest = sp_u64_sub(rest, sp_oss_layer_base64(n.x, layer.x));
                     bottom = sp_u64_sub(n, sp_u64_shift_left(layer, 1u));
                 }
-                uvec2 triangle_count = sp_oss_triangle_count64(bottom);
-                uint triangle_remainder = (bottom.x % 3u + bottom.y % 3u) % 3u; // 2^32 = 1 (mod 3)
-                triangle_remainder = (triangle_remainder * triangle_remainder + triangle_remainder + 1u) % 3u;
-                uvec2 row_count = sp_u128_div_small(uvec4(sp_u64_add(sp_u64_shift_left(bottom, 1u), uvec2(1u, 0u)), 0u, 0u), 3u).xy;
-                float estimate = sp_oss_row_estimate(sp_u64_to_float(bottom),
-                                                     sp_u64_to_float(sp_u64_sub(triangle_count, rest)),
-                                                     float(triangle_remainder));
-                row = sp_oss_search64(false, bottom, sp_u64_sub(row_count, uvec2(1u, 0u)), estimate, rest);
-                rest = sp_u64_sub(rest, sp_oss_row_base64(bottom, row));
-                q[3] = k == 4u ? layer : uvec2(0u);
-                q[2] = sp_u64_add(row, layer);
-                q[1] = sp_u64_add(rest, q[2]);
+                if (rows32) { // K = 4 with S(N) < 2^32: the row step in 32 bits
+                    uint remainder32, b32 = bottom.x;
+                    uint count32 = sp_oss_triangle_count_in_layer32(b32, remainder32);
+                    float estimate = sp_oss_row_estimate(float(b32), float(count32 - rest.x), float(remainder32));
+                    uint row32 = sp_oss_row_search_in_layer32(b32, (2u * b32 + 1u) / 3u - 1u, estimate, rest.x);
+                    uint i32 = rest.x - sp_oss_row_base_in_layer32(b32, row32);
+                    q[3] = layer;
+                    q[2] = uvec2(row32 + layer.x, 0u);
+                    q[1] = uvec2(i32 + row32 + layer.x, 0u);
+                } else {
+                    uvec2 triangle_count = sp_oss_triangle_count64(bottom);
+                    uint triangle_remainder = (bottom.x % 3u + bottom.y % 3u) % 3u; // 2^32 = 1 (mod 3)
+                    triangle_remainder = (triangle_remainder * triangle_remainder + triangle_remainder + 1u) % 3u;
+                    uvec2 row_count = sp_u128_div_small(uvec4(sp_u64_add(sp_u64_shift_left(bottom, 1u), uvec2(1u, 0u)), 0u, 0u), 3u).xy;
+                    float estimate = sp_oss_row_estimate(sp_u64_to_float(bottom),
+                                                         sp_u64_to_float(sp_u64_sub(triangle_count, rest)),
+                                                         float(triangle_remainder));
+                    row = sp_oss_search64(false, bottom, sp_u64_sub(row_count, uvec2(1u, 0u)), estimate, rest);
+                    rest = sp_u64_sub(rest, sp_oss_row_base64(bottom, row));
+                    q[3] = k == 4u ? layer : uvec2(0u);
+                    q[2] = sp_u64_add(row, layer);
+                    q[1] = sp_u64_add(rest, q[2]);
+                }
             }
         } else {
             uint first = method == SP_METHOD_FIXED ? 0u : 1u;
@@ -439,6 +533,12 @@ vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec
     q_low = uvec4(q[0].x, q[1].x, q[2].x, q[3].x);
     q_high = uvec4(q[0].y, q[1].y, q[2].y, q[3].y);
     return w;
+}
+
+// The wide decoder with the cheapest row step exact for the codec.
+vec4 sp_decode_weights64(SpGpuCodec codec, uvec2 code, out uvec4 q_low, out uvec4 q_high)
+{
+    return sp_decode_weights64_rows(codec, code, SP_GPU_CODEC_ROWS32(codec), q_low, q_high);
 }
 
 // Either decoder, whichever is exact for the codec (a uniform branch: all vertices agree).

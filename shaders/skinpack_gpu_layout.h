@@ -94,7 +94,14 @@ typedef struct SpSkinParameters {
  */
 #define SP_SPEC_RUNTIME 0xffffffffu
 #define SP_SPEC_DECODER_NARROW 0u
-#define SP_SPEC_DECODER_WIDE 1u
+#define SP_SPEC_DECODER_WIDE 1u        /* 64-bit decoder, 64-bit row step */
+#define SP_SPEC_DECODER_WIDE_ROWS32 2u /* 64-bit layer step, 32-bit row step: SP_GPU_CODEC_ROWS32 */
+
+/* OSS K = 4 codes whose in-layer indices are below S(N) < 2^32: the 64-bit decoder may take the
+ * row step in 32 bits (codes of up to 46 bits). 113511 is the largest N with S(N) < 2^32. */
+#define SP_OSS_LAYER32_MAX_N 113511u
+#define SP_GPU_CODEC_ROWS32(c)                                                                             \
+    ((c).config.x == SP_METHOD_OSS && (c).config.y == 4u && (c).n_scale.y == 0u && (c).n_scale.x <= SP_OSS_LAYER32_MAX_N)
 
 /* Descriptor set 0 of every skinpack shader (all storage buffers except the codec block). */
 #define SP_BINDING_CODEC 0        /* uniform SpGpuCodec */

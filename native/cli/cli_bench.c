@@ -1,7 +1,10 @@
 /*
- * skinpack bench [--json] [--vertices N]: single-thread throughput of every codec's batch
- * encode and decode and of the tuple-table build, as ratios to memcpy of the same input bytes
- * (4 u8 joints + 4 float weights = 20 bytes a vertex) measured in the same run.
+ * skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512]: single-thread
+ * throughput of every codec's batch encode and decode and of the tuple-table build, as ratios to
+ * a memcpy of the 4 float weights (16 bytes a vertex) timed right before each repetition. Rates
+ * are medians of R repetitions, ratios the medians of the per-repetition ratios (the machine may
+ * be shared); --isa caps the vector paths (the widest the CPU has by default), so one binary
+ * measures every path.
  */
 #include <math.h>
 #include <stdio.h>
@@ -9,12 +12,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "../src/codec_internal.h" /* sp_isa and the capped batch forms */
 #include "commands.h"
 #include "skinpack.h"
 
-#define REPEATS 5
-#define INPUT_BYTES_PER_VERTEX 20
-
+#define DEFAULT_REPEATS 7
+#define MAX_REPEATS 101
+#define INPUT_BYTES_PER_VERTEX 16
 static double now_seconds(void)
 {
     struct timespec ts;
@@ -58,112 +62,232 @@ static void make_influences(size_t count, uint16_t* joints, float* weights)
 }
 
 
-static double vertices_per_second(size_t count, double seconds)
+typedef struct bench_options {
+    int json;
+    size_t count;
+    int repeats;
+    sp_isa isa;
+} bench_options;
+
+static const char* const isa_names[] = {"scalar", "avx2", "avx512"};
+
+static int parse_options(int argc, char** argv, bench_options* o)
+{
+    o->json = 0, o->count = 1000000, o->repeats = DEFAULT_REPEATS, o->isa = SP_ISA_AVX512;
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--json") == 0) o->json = 1;
+        else if (strcmp(argv[i], "--vertices") == 0 && i + 1 < argc) o->count = strtoull(argv[++i], NULL, 10);
+        else if (strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) o->repeats = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--isa") == 0 && i + 1 < argc) {
+            const char* name = argv[++i];
+            int found = -1;
+            for (int n = 0; n < 3; ++n)
+                if (strcmp(name, isa_names[n]) == 0) found = n;
+            if (found < 0) {
+                fprintf(stderr, "Error: --isa %s: expected scalar, avx2 or avx512\n", name);
+                return 0;
+            }
+            o->isa = (sp_isa)found;
+        } else {
+            fprintf(stderr, "usage: skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512]\n");
+            return 0;
+        }
+    }
+    if (o->count < 1000) o->count = 1000;
+    if (o->repeats < 1) o->repeats = 1;
+    if (o->repeats > MAX_REPEATS) o->repeats = MAX_REPEATS;
+    return 1;
+}
+
+static int compare_doubles(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double* samples, int count)
+{
+    qsort(samples, (size_t)count, sizeof(double), compare_doubles);
+    return count % 2 ? samples[count / 2] : 0.5 * (samples[count / 2 - 1] + samples[count / 2]);
+}
+
+static double rate(size_t count, double seconds)
 {
     return seconds > 0 ? (double)count / seconds : 0;
 }
 
+/* Buffers of one run, sized for K = 4. */
+typedef struct bench_buffers {
+    uint16_t* joints;
+    float *weights, *decoded, *narrowed;
+    uint64_t* codes;
+    uint8_t* significant;
+    uint32_t* tuple_index;
+    uint16_t* lut;
+    void* scratch;
+    size_t scratch_size;
+    unsigned char *copy_src, *copy_dst;
+} bench_buffers;
+
+static int allocate(size_t count, bench_buffers* b)
+{
+    b->joints = malloc(count * 4 * sizeof(uint16_t));
+    b->weights = malloc(count * 4 * sizeof(float));
+    b->decoded = malloc(count * 4 * sizeof(float));
+    b->narrowed = malloc(count * 4 * sizeof(float));
+    b->codes = malloc(count * sizeof(uint64_t));
+    b->significant = malloc(count);
+    b->tuple_index = malloc(count * sizeof(uint32_t));
+    b->lut = malloc(count * 4 * sizeof(uint16_t));
+    b->scratch_size = sp_tuple_lut_scratch_bound(count, 4);
+    b->scratch = malloc(b->scratch_size);
+    b->copy_src = malloc(count * INPUT_BYTES_PER_VERTEX);
+    b->copy_dst = malloc(count * INPUT_BYTES_PER_VERTEX);
+    return b->joints && b->weights && b->decoded && b->narrowed && b->codes && b->significant && b->tuple_index &&
+           b->lut && b->scratch && b->copy_src && b->copy_dst;
+}
+
+static void release(bench_buffers* b)
+{
+    free(b->joints), free(b->weights), free(b->decoded), free(b->narrowed), free(b->codes), free(b->significant);
+    free(b->tuple_index), free(b->lut), free(b->scratch), free(b->copy_src), free(b->copy_dst);
+}
+
+/* One timed memcpy of the weights' bytes (the baseline of every ratio, taken next to what it
+ * is compared with, so that a busy spell of the shared machine slows both). */
+static double time_memcpy(const bench_options* o, bench_buffers* b, int r)
+{
+    size_t bytes = o->count * INPUT_BYTES_PER_VERTEX;
+    double t0 = now_seconds();
+    memcpy(b->copy_dst, b->copy_src, bytes);
+    double t = now_seconds() - t0;
+    b->copy_src[r % 64] ^= b->copy_dst[bytes - 1 - r % 64]; /* keep the copy observable */
+    return t;
+}
+
+/* A measured rate and its ratio to memcpy: medians over the repetitions of each alone, and the
+ * median of the per-repetition ratios. */
+typedef struct bench_rate {
+    double per_s, ratio;
+} bench_rate;
+
+static bench_rate summarise(const bench_options* o, double* seconds, double* copy_seconds)
+{
+    double ratios[MAX_REPEATS];
+    for (int r = 0; r < o->repeats; ++r) ratios[r] = seconds[r] > 0 ? copy_seconds[r] / seconds[r] : 0;
+    bench_rate result = {rate(o->count, median(seconds, o->repeats)), median(ratios, o->repeats)};
+    return result;
+}
+
+static double memcpy_rate(const bench_options* o, bench_buffers* b)
+{
+    double t[MAX_REPEATS];
+    memcpy(b->copy_dst, b->copy_src, o->count * INPUT_BYTES_PER_VERTEX); /* untimed: faults the pages in */
+    for (int r = 0; r < o->repeats; ++r) t[r] = time_memcpy(o, b, r);
+    return rate(o->count, median(t, o->repeats));
+}
+
+static bench_rate lut_rate(const bench_options* o, bench_buffers* b, size_t* lut_size)
+{
+    double t[MAX_REPEATS], copy[MAX_REPEATS];
+    sp_codec codec;
+    sp_codec_from_bits(SP_METHOD_OSS, 4, 22, &codec);
+    sp_encode_weights_batch(&codec, b->weights, o->count, b->codes, b->significant);
+    for (int r = 0; r < o->repeats; ++r) {
+        copy[r] = time_memcpy(o, b, r);
+        double t0 = now_seconds();
+        sp_build_tuple_lut(b->joints, b->significant, o->count, 4, b->lut, lut_size, b->tuple_index, b->scratch,
+                           b->scratch_size);
+        t[r] = now_seconds() - t0;
+    }
+    return summarise(o, t, copy);
+}
+
+/* Encode and decode rates of one codec over the narrowed K-wide weights. */
+static void codec_rates(const bench_options* o, bench_buffers* b, const sp_codec* codec, bench_rate* encode,
+                        bench_rate* decode)
+{
+    double te[MAX_REPEATS], td[MAX_REPEATS], copy_e[MAX_REPEATS], copy_d[MAX_REPEATS];
+    for (int r = 0; r < o->repeats; ++r) {
+        copy_e[r] = time_memcpy(o, b, r);
+        double t0 = now_seconds();
+        sp_encode_weights_batch_isa(codec, b->narrowed, o->count, b->codes, NULL, o->isa);
+        te[r] = now_seconds() - t0;
+        copy_d[r] = time_memcpy(o, b, r);
+        t0 = now_seconds();
+        sp_decode_weights_batch_isa(codec, b->codes, o->count, b->decoded, NULL, o->isa);
+        td[r] = now_seconds() - t0;
+    }
+    *encode = summarise(o, te, copy_e);
+    *decode = summarise(o, td, copy_d);
+}
+
+/* The K heaviest weights of each vertex, renormalised: what a K-influence skin holds. */
+static void narrow(const bench_options* o, bench_buffers* b, uint32_t k)
+{
+    for (size_t v = 0; v < o->count; ++v) {
+        float sum = 0;
+        for (uint32_t i = 0; i < k; ++i) sum += b->weights[v * 4 + i];
+        for (uint32_t i = 0; i < k; ++i) b->narrowed[v * k + i] = b->weights[v * 4 + i] / sum;
+    }
+}
+
 int skinpack_cmd_bench(int argc, char** argv)
 {
-    int json = 0;
-    size_t count = 1000000;
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--json") == 0) json = 1;
-        else if (strcmp(argv[i], "--vertices") == 0 && i + 1 < argc) count = strtoull(argv[++i], NULL, 10);
-        else {
-            fprintf(stderr, "usage: skinpack bench [--json] [--vertices N]\n");
-            return 2;
-        }
-    }
-    if (count < 1000) count = 1000;
-    uint16_t* joints = malloc(count * 4 * sizeof(uint16_t));
-    float* weights = malloc(count * 4 * sizeof(float));
-    float* decoded = malloc(count * 4 * sizeof(float));
-    float* narrowed = malloc(count * 4 * sizeof(float));
-    uint64_t* codes = malloc(count * sizeof(uint64_t));
-    uint8_t* significant = malloc(count);
-    uint32_t* tuple_index = malloc(count * sizeof(uint32_t));
-    uint16_t* lut = malloc(count * 4 * sizeof(uint16_t));
-    size_t scratch_size = sp_tuple_lut_scratch_bound(count, 4);
-    void* scratch = malloc(scratch_size);
-    unsigned char* copy_src = malloc(count * INPUT_BYTES_PER_VERTEX);
-    unsigned char* copy_dst = malloc(count * INPUT_BYTES_PER_VERTEX);
-    if (!joints || !weights || !decoded || !narrowed || !codes || !significant || !tuple_index || !lut || !scratch ||
-        !copy_src || !copy_dst) {
-        fprintf(stderr, "skinpack bench: out of memory for %zu vertices\n", count);
+    bench_options o;
+    bench_buffers b;
+    if (!parse_options(argc, argv, &o)) return 2;
+    if (!allocate(o.count, &b)) {
+        fprintf(stderr, "Error: skinpack bench: out of memory for %zu vertices\n", o.count);
+        release(&b);
         return 1;
     }
-    make_influences(count, joints, weights);
-    for (size_t i = 0; i < count * INPUT_BYTES_PER_VERTEX; ++i) copy_src[i] = (unsigned char)next_random();
-
-    double best = 1e30;
-    for (int r = 0; r < REPEATS; ++r) {
-        double t0 = now_seconds();
-        memcpy(copy_dst, copy_src, count * INPUT_BYTES_PER_VERTEX);
-        best = fmin(best, now_seconds() - t0);
-        copy_src[r] ^= copy_dst[count * INPUT_BYTES_PER_VERTEX - 1 - r]; /* keep the copy observable */
-    }
-    double memcpy_rate = vertices_per_second(count, best);
-
-    sp_codec lut_codec;
-    sp_codec_from_bits(SP_METHOD_OSS, 4, 22, &lut_codec);
-    sp_encode_weights_batch(&lut_codec, weights, count, codes, significant);
-    best = 1e30;
+    make_influences(o.count, b.joints, b.weights);
+    for (size_t i = 0; i < o.count * INPUT_BYTES_PER_VERTEX; ++i) b.copy_src[i] = (unsigned char)next_random();
+    sp_isa cpu = sp_cpu_isa(), isa = cpu < o.isa ? cpu : o.isa;
+    double copy = memcpy_rate(&o, &b);
     size_t lut_size = 0;
-    for (int r = 0; r < REPEATS; ++r) {
-        double t0 = now_seconds();
-        sp_build_tuple_lut(joints, significant, count, 4, lut, &lut_size, tuple_index, scratch, scratch_size);
-        best = fmin(best, now_seconds() - t0);
-    }
-    double lut_rate = vertices_per_second(count, best);
+    bench_rate lut = lut_rate(&o, &b, &lut_size);
 
-    if (json) printf("{\"vertices\": %zu, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
-                     "\"lut_build_ratio\": %.3f, \"codecs\": [", count, memcpy_rate, lut_rate, lut_rate / memcpy_rate);
+    if (o.json)
+        printf("{\"vertices\": %zu, \"repeats\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
+               "\"memcpy_bytes_per_vertex\": %d, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
+               "\"lut_build_ratio\": %.3f, \"lut_size\": %zu, \"codecs\": [",
+               o.count, o.repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut.per_s, lut.ratio,
+               lut_size);
     else {
-        printf("skinpack bench: %zu vertices, single thread, best of %d\n", count, REPEATS);
-        printf("memcpy (20 B/vertex)  %8.1f M vertices/s\n", memcpy_rate / 1e6);
-        printf("tuple table build     %8.1f M vertices/s  (%.2fx memcpy, %zu tuples)\n\n", lut_rate / 1e6,
-               lut_rate / memcpy_rate, lut_size);
+        printf("skinpack bench: %zu vertices, single thread, median of %d, vector path %s (CPU: %s)\n", o.count,
+               o.repeats, isa_names[isa], isa_names[cpu]);
+        printf("memcpy (16 B/vertex)  %8.1f M vertices/s\n", copy / 1e6);
+        printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut.per_s / 1e6, lut.ratio,
+               lut_size);
         printf("%-6s %2s %4s  %10s %7s  %10s %7s\n", "method", "K", "bits", "encode M/s", "ratio", "decode M/s",
                "ratio");
     }
     int first = 1;
-    static const uint32_t budgets[] = {22, 38};
+    static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
     for (uint32_t k = 2; k <= 4; ++k) {
-        /* the K heaviest weights of each vertex, renormalised: what a K-influence skin holds */
-        for (size_t v = 0; v < count; ++v) {
-            float sum = 0;
-            for (uint32_t i = 0; i < k; ++i) sum += weights[v * 4 + i];
-            for (uint32_t i = 0; i < k; ++i) narrowed[v * k + i] = weights[v * 4 + i] / sum;
-        }
+        narrow(&o, &b, k);
         for (int m = 0; m < SP_METHOD_COUNT; ++m)
-            for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+            for (size_t i = 0; i < sizeof(budgets) / sizeof(budgets[0]); ++i) {
                 sp_codec codec;
-                if (sp_codec_from_bits((sp_method)m, k, budgets[b], &codec) != SP_OK) continue;
-                double encode_best = 1e30, decode_best = 1e30;
-                for (int r = 0; r < REPEATS; ++r) {
-                    double t0 = now_seconds();
-                    sp_encode_weights_batch(&codec, narrowed, count, codes, NULL);
-                    double t1 = now_seconds();
-                    sp_decode_weights_batch(&codec, codes, count, decoded, NULL);
-                    double t2 = now_seconds();
-                    encode_best = fmin(encode_best, t1 - t0);
-                    decode_best = fmin(decode_best, t2 - t1);
-                }
-                double enc = vertices_per_second(count, encode_best), dec = vertices_per_second(count, decode_best);
-                if (json)
-                    printf("%s{\"method\": \"%s\", \"influences\": %u, \"bits\": %u, \"encode_vertices_per_s\": %.0f, "
-                           "\"decode_vertices_per_s\": %.0f, \"encode_ratio\": %.3f, \"decode_ratio\": %.3f}",
-                           first ? "" : ", ", sp_method_name((sp_method)m), k, codec.bits, enc, dec,
-                           enc / memcpy_rate, dec / memcpy_rate);
+                bench_rate enc, dec;
+                if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
+                codec_rates(&o, &b, &codec, &enc, &dec);
+                int vector = m == SP_METHOD_OSS && isa > SP_ISA_SCALAR && sp_oss_batch_supported(&codec);
+                if (o.json)
+                    printf("%s{\"method\": \"%s\", \"influences\": %u, \"budget\": %u, \"bits\": %u, "
+                           "\"vector\": %s, \"encode_vertices_per_s\": %.0f, \"decode_vertices_per_s\": %.0f, "
+                           "\"encode_ratio\": %.3f, \"decode_ratio\": %.3f}",
+                           first ? "" : ", ", sp_method_name((sp_method)m), k, budgets[i], codec.bits,
+                           vector ? "true" : "false", enc.per_s, dec.per_s, enc.ratio, dec.ratio);
                 else
-                    printf("%-6s %2u %4u  %10.1f %6.2fx  %10.1f %6.2fx\n", sp_method_name((sp_method)m), k,
-                           codec.bits, enc / 1e6, enc / memcpy_rate, dec / 1e6, dec / memcpy_rate);
+                    printf("%-6s %2u %4u  %10.1f %6.3fx  %10.1f %6.3fx%s\n", sp_method_name((sp_method)m), k,
+                           codec.bits, enc.per_s / 1e6, enc.ratio, dec.per_s / 1e6, dec.ratio, vector ? "" : "  (scalar)");
                 first = 0;
             }
     }
-    if (json) printf("]}\n");
-    free(joints); free(weights); free(decoded); free(narrowed); free(codes); free(significant);
-    free(tuple_index); free(lut); free(scratch); free(copy_src); free(copy_dst);
+    if (o.json) printf("]}\n");
+    release(&b);
     return 0;
 }

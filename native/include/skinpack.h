@@ -174,8 +174,9 @@ SP_API uint64_t sp_encode_weights(const sp_codec* codec, const float* weights);
 SP_API void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights);
 
 /* Batch forms over vertex_count vertices of K weights. significant (vertex_count entries, may be
- * NULL) receives how many leading weights are non-zero after quantisation: the remaining slots
- * are "don't care" for the tuple table. */
+ * NULL) receives one past the last slot whose weight is non-zero after quantisation (Any can
+ * leave a zero slot before a non-zero one): the remaining slots are "don't care" for the tuple
+ * table. */
 SP_API sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
                                          uint64_t* codes, uint8_t* significant);
 SP_API sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,

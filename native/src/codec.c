@@ -51,10 +51,11 @@ static sp_result configure_oss(uint32_t k, uint64_t n, sp_codec* codec)
 {
     if (n < 2 || n > ((uint64_t)1 << 63)) return SP_ERR_BITS_OUT_OF_RANGE;
     sp_u128 count = sp_oss_code_count(n, k);
-    if (count == 0 || count - 1 > UINT64_MAX) return SP_ERR_BITS_OUT_OF_RANGE;
+    uint64_t low = sp_u128_low(count), high = sp_u128_high(count);
+    if ((low == 0 && high == 0) || high > 1 || (high == 1 && low != 0)) return SP_ERR_BITS_OUT_OF_RANGE; /* 1..2^64 */
     codec->n = n;
     codec->scale = 2 * (n - 1);
-    codec->max_code = (uint64_t)(count - 1);
+    codec->max_code = low - 1; /* 2^64 wraps to 2^64 - 1 */
     codec->max_spacing = 1.0 / (double)codec->scale;
     codec->max_error = (double)(k - 1) / ((double)k * (double)codec->scale) + SP_FLOAT_SLACK;
     return SP_OK;
@@ -86,15 +87,15 @@ static sp_result any_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
 {
     uint64_t q[SP_MAX_INFLUENCES - 1];
     uint32_t axes = k - 1;
-    sp_u128 limit = (sp_u128)1 << bits; /* bits <= 64 */
+    sp_u128 limit = sp_u128_pow2(bits); /* bits <= 64 */
     double volume = 1;
     for (uint32_t a = 0; a < axes; ++a) volume /= (double)(a + 2);
     double lambda = pow(ldexp(1.0, (int)bits) / volume, 1.0 / (double)axes);
-    sp_u128 product = 1;
+    sp_u128 product = sp_u128_from(1);
     for (uint32_t a = 0; a < axes; ++a) {
         double qa = floor(lambda / (double)(a + 2));
         q[a] = qa < 2 ? 2 : (qa > 0x1p62 ? ((uint64_t)1 << 62) : (uint64_t)qa);
-        product *= q[a];
+        product = sp_u128_mul_u64(product, q[a]);
     }
     for (int step = 0; step < 256; ++step) {
         uint32_t coarse = 0, second = axes; /* coarsest axis, and the next coarsest */
@@ -103,27 +104,27 @@ static sp_result any_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
         for (uint32_t a = 0; a < axes; ++a)
             if (a != coarse && (second == axes || any_resolution(a, q[a]) < any_resolution(second, q[second])))
                 second = a;
-        sp_u128 others = product / q[coarse];
-        if (product > limit) { /* float rounding of lambda: cut the finest axis to fit */
+        sp_u128 others = sp_u128_div_u64(product, q[coarse]);
+        if (sp_u128_less(limit, product)) { /* float rounding of lambda: cut the finest axis to fit */
             uint32_t fine = 0;
             for (uint32_t a = 1; a < axes; ++a)
                 if (any_resolution(a, q[a]) > any_resolution(fine, q[fine])) fine = a;
-            sp_u128 fit = limit / (product / q[fine]);
-            if (fit < 2) return SP_ERR_BITS_OUT_OF_RANGE;
-            product = product / q[fine] * fit;
-            q[fine] = (uint64_t)fit;
+            sp_u128 rest = sp_u128_div_u64(product, q[fine]);
+            sp_u128 fit = sp_u128_div(limit, rest); /* <= limit < 2^65; >= 2 fits 64 bits below */
+            if (sp_u128_less(fit, sp_u128_from(2))) return SP_ERR_BITS_OUT_OF_RANGE;
+            q[fine] = sp_u128_high(fit) ? UINT64_MAX : sp_u128_low(fit);
+            product = sp_u128_mul_u64(rest, q[fine]);
             continue;
         }
-        sp_u128 room = limit / others;
-        if (room > UINT64_MAX) room = UINT64_MAX;
-        if (room <= q[coarse]) break;
-        uint64_t target = (uint64_t)room;
+        sp_u128 room = sp_u128_div(limit, others);
+        uint64_t target = sp_u128_high(room) ? UINT64_MAX : sp_u128_low(room);
+        if (target <= q[coarse]) break;
         if (second < axes) { /* just past the next coarsest axis, so the two stay balanced */
             double match = any_resolution(second, q[second]) / (double)(coarse + 2) + 2;
             if (match < (double)target) target = (uint64_t)match;
             if (target <= q[coarse]) target = q[coarse] + 1;
         }
-        product = others * target;
+        product = sp_u128_mul_u64(others, target);
         q[coarse] = target;
     }
     return sp_any_configure(k, q, codec);
@@ -131,14 +132,14 @@ static sp_result any_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
 
 static sp_result oss_from_bits(uint32_t k, uint32_t bits, sp_codec* codec)
 {
-    sp_u128 limit = bits >= 64 ? (sp_u128)UINT64_MAX + 1 : ((sp_u128)1 << bits);
+    sp_u128 limit = sp_u128_pow2(bits >= 64 ? 64 : bits);
     uint64_t lo = 2, hi = (uint64_t)1 << 63;
     if (k == 3) hi = (uint64_t)1 << 34;
     if (k == 4) hi = (uint64_t)1 << 23;
-    if (sp_oss_code_count(lo, k) > limit) return SP_ERR_BITS_OUT_OF_RANGE;
+    if (sp_u128_less(limit, sp_oss_code_count(lo, k))) return SP_ERR_BITS_OUT_OF_RANGE;
     while (lo < hi) { /* largest N whose code count fits */
         uint64_t mid = lo + (hi - lo + 1) / 2;
-        if (sp_oss_code_count(mid, k) <= limit) lo = mid;
+        if (!sp_u128_less(limit, sp_oss_code_count(mid, k))) lo = mid;
         else hi = mid - 1;
     }
     return configure_oss(k, lo, codec);
@@ -256,7 +257,7 @@ sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spa
             double n = ceil(1.0 / (2.0 * max_spacing)) + 1;
             while (n > 2 && 1.0 / (2.0 * (n - 2)) <= max_spacing) n -= 1;
             if (n > 0x1p40) return SP_ERR_BITS_OUT_OF_RANGE;
-            total = log2((double)sp_oss_code_count((uint64_t)n, k));
+            total = log2(sp_u128_to_double(sp_oss_code_count((uint64_t)n, k)));
         } else {
             for (uint32_t a = 0; a + 1 < k; ++a) {
                 double q = ceil(1.0 / ((double)(a + 2) * max_spacing)) + 1;
@@ -279,7 +280,7 @@ sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spa
 /* ---- encode / decode ---------------------------------------------------------------- */
 
 /* Inlined with a constant k by the batch loop below. */
-static inline __attribute__((always_inline)) uint64_t encode_one(const sp_codec* codec, const float* weights,
+SP_INLINE uint64_t encode_one(const sp_codec* codec, const float* weights,
                                                                  uint32_t k, uint8_t* significant)
 {
     uint64_t q[SP_MAX_INFLUENCES] = {0};
@@ -292,32 +293,24 @@ static inline __attribute__((always_inline)) uint64_t encode_one(const sp_codec*
         float decoded[SP_MAX_INFLUENCES];
         code = sp_any_encode(codec, weights);
         if (significant) {
+            /* Any's axes round on grids of their own: a slot can decode to 0 with weight after it */
             sp_any_decode(codec, code, decoded);
             uint8_t count = 1;
-            while (count < k && decoded[count] > 0) ++count;
+            for (uint8_t i = 1; i < k; ++i)
+                if (decoded[i] > 0) count = (uint8_t)(i + 1);
             *significant = count;
         }
         return code;
     }
     sp_grid_quantize(weights, k, codec->scale, q);
     code = codec->method == SP_METHOD_OSS ? sp_oss_pack(codec->n, k, q) : sp_grid_pack(codec, q);
-    if (significant) {
-        uint8_t count = 1;
-        while (count < k && q[count] > 0) ++count;
-        *significant = count;
-    }
+    if (significant) *significant = sp_grid_significant(q, k);
     return code;
 }
 
 uint64_t sp_encode_weights(const sp_codec* codec, const float* weights)
 {
     return encode_one(codec, weights, codec->influences, NULL);
-}
-
-static void grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
-{
-    double inv = 1.0 / (double)scale;
-    for (uint32_t i = 0; i < k; ++i) weights[i] = (float)((double)q[i] * inv);
 }
 
 void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
@@ -328,10 +321,11 @@ void sp_decode_weights(const sp_codec* codec, uint64_t code, float* weights)
         weights[0] = 1.0f;
     } else if (codec->method == SP_METHOD_ANY) {
         sp_any_decode(codec, code, weights);
+    } else if (codec->method == SP_METHOD_OSS) {
+        sp_oss_decode_one(codec, code, weights);
     } else {
-        if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);
-        else sp_grid_unpack(codec, code, q);
-        grid_to_weights(q, k, codec->scale, weights);
+        sp_grid_unpack(codec, code, q);
+        sp_grid_to_weights(q, k, codec->scale, weights);
     }
 }
 
@@ -343,32 +337,39 @@ static int decode_valid(const sp_codec* codec, uint64_t code, float* weights)
     uint32_t k = codec->influences;
     float decoded[SP_MAX_INFLUENCES];
     if (code > codec->max_code) return 0;
+    if (codec->method == SP_METHOD_OSS && k > 1) { /* a bijection: every code in range is a sorted grid point */
+        sp_oss_decode_one(codec, code, weights);
+        return 1;
+    }
     if (k == 1) {
         decoded[0] = 1.0f;
     } else if (codec->method == SP_METHOD_ANY) {
         if (sp_any_decode(codec, code, decoded) < 0) return 0; /* the stored weights sum past 1 */
     } else {
         uint64_t q[SP_MAX_INFLUENCES] = {0};
-        if (codec->method == SP_METHOD_OSS) sp_oss_unpack(codec->n, k, code, q);
-        else sp_grid_unpack(codec, code, q); /* clamps q[0] at 0, so a sum past s shows below */
-        sp_u128 sum = q[0];
+        sp_grid_unpack(codec, code, q); /* clamps q[0] at 0, so a sum past s shows below */
+        sp_u128 sum = sp_u128_from(q[0]);
         for (uint32_t i = 1; i < k; ++i) {
             if (q[i] > q[i - 1]) return 0;
-            sum += q[i];
+            sum = sp_u128_add_u64(sum, q[i]);
         }
-        if (sum != codec->scale) return 0;
-        grid_to_weights(q, k, codec->scale, decoded);
+        if (sp_u128_high(sum) || sp_u128_low(sum) != codec->scale) return 0;
+        sp_grid_to_weights(q, k, codec->scale, decoded);
     }
     for (uint32_t i = 0; i < k; ++i) weights[i] = decoded[i];
     return 1;
 }
 
 sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weights, size_t vertex_count,
-                                      uint64_t* codes, uint8_t* significant, sp_oss_isa widest)
+                                      uint64_t* codes, uint8_t* significant, sp_isa widest)
 {
     if (!codec || (!weights && vertex_count) || (!codes && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
     size_t first = sp_oss_encode_batch(codec, weights, vertex_count, codes, significant, widest); /* vector prefix */
+    if (codec->method == SP_METHOD_OSS && k >= 2 && k <= 4) {
+        sp_oss_encode_scalar(codec, weights, first, vertex_count, codes, significant);
+        return SP_OK;
+    }
 #define SP_ENCODE_LOOP(K)                                                                            \
     for (size_t v = first; v < vertex_count; ++v)                                                   \
         codes[v] = encode_one(codec, weights + v * (K), (K), significant ? significant + v : NULL);
@@ -383,11 +384,13 @@ sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weight
 }
 
 sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,
-                                      float* weights, size_t* error_vertex, sp_oss_isa widest)
+                                      float* weights, size_t* error_vertex, sp_isa widest)
 {
     if (!codec || (!codes && vertex_count) || (!weights && vertex_count)) return SP_ERR_INVALID_ARGUMENT;
     uint32_t k = codec->influences;
     size_t first = sp_oss_decode_batch(codec, codes, vertex_count, weights, widest); /* vector prefix */
+    if (codec->method == SP_METHOD_OSS && k >= 2 && k <= 4)
+        first = sp_oss_decode_scalar(codec, codes, first, vertex_count, weights); /* stops at an invalid code */
     for (size_t v = first; v < vertex_count; ++v) {
         if (!decode_valid(codec, codes[v], weights + v * k)) {
             if (error_vertex) *error_vertex = v;
@@ -400,11 +403,11 @@ sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* cod
 sp_result sp_encode_weights_batch(const sp_codec* codec, const float* weights, size_t vertex_count,
                                   uint64_t* codes, uint8_t* significant)
 {
-    return sp_encode_weights_batch_isa(codec, weights, vertex_count, codes, significant, SP_OSS_ISA_AVX512);
+    return sp_encode_weights_batch_isa(codec, weights, vertex_count, codes, significant, SP_ISA_AVX512);
 }
 
 sp_result sp_decode_weights_batch(const sp_codec* codec, const uint64_t* codes, size_t vertex_count, float* weights,
                                   size_t* error_vertex)
 {
-    return sp_decode_weights_batch_isa(codec, codes, vertex_count, weights, error_vertex, SP_OSS_ISA_AVX512);
+    return sp_decode_weights_batch_isa(codec, codes, vertex_count, weights, error_vertex, SP_ISA_AVX512);
 }

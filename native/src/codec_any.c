@@ -67,13 +67,13 @@ double sp_any_decode(const sp_codec* codec, uint64_t code, float* weights)
 
 sp_result sp_any_configure(uint32_t influences, const uint64_t* axis_samples, sp_codec* codec)
 {
-    sp_u128 count = 1;
+    sp_u128 count = sp_u128_from(1);
     double spacing = 0, w1_error = 0;
     for (uint32_t a = 0; a + 1 < influences; ++a) {
         uint64_t q = axis_samples[a];
         if (q < 2) return SP_ERR_INVALID_ARGUMENT;
-        count *= q;
-        if (count > ((sp_u128)1 << 64)) return SP_ERR_BITS_OUT_OF_RANGE;
+        count = sp_u128_mul_u64(count, q);
+        if (sp_u128_less(sp_u128_pow2(64), count)) return SP_ERR_BITS_OUT_OF_RANGE;
         double h = axis_spacing(a, q);
         if (h > spacing) spacing = h;
         w1_error += h / 2;
@@ -81,7 +81,7 @@ sp_result sp_any_configure(uint32_t influences, const uint64_t* axis_samples, sp
     }
     codec->n = 0;
     codec->scale = 0;
-    codec->max_code = (uint64_t)(count - 1); /* count <= 2^64, so max_code fits */
+    codec->max_code = sp_u128_low(count) - 1; /* count <= 2^64 (2^64 wraps to 0, minus 1: 2^64 - 1) */
     codec->max_spacing = spacing;
     codec->max_error = w1_error + SP_FLOAT_SLACK;
     return SP_OK;

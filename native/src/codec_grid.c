@@ -6,7 +6,7 @@
 #include "codec_internal.h"
 
 /* Slot order by descending remainder, ties to the lower slot (stable insertion sort). */
-static void order_by_remainder(const double* remainder, uint32_t k, uint32_t* order)
+SP_INLINE void order_by_remainder(const double* remainder, uint32_t k, uint32_t* order)
 {
     for (uint32_t i = 0; i < k; ++i) {
         uint32_t j = i;
@@ -18,24 +18,20 @@ static void order_by_remainder(const double* remainder, uint32_t k, uint32_t* or
     }
 }
 
-/* floor(x) for 0 <= x, clamped to [0, limit]; long double keeps all 64 bits of large grids. */
-static uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
+/* floor(x) for 0 <= x, clamped to [0, limit] (NaN to 0); long double keeps all 64 bits of large
+ * grids. Selects, not branches: zero weights come in no predictable order. */
+SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
 {
-    if (!(x > 0)) {
-        *remainder = 0;
-        return 0;
-    }
-    if (x >= (long double)limit) {
-        *remainder = 0;
-        return limit;
-    }
+    long double top = (long double)limit;
+    x = x > 0 ? x : 0;
+    x = x < top ? x : top;
     uint64_t f = (uint64_t)x;
     *remainder = (double)(x - (long double)f);
     return f;
 }
 
 /* General rounding: any grid size, any deficit (also the rare wrap-around of huge grids). */
-static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
+SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     double remainder[SP_MAX_INFLUENCES];
     uint32_t order[SP_MAX_INFLUENCES];
@@ -43,25 +39,26 @@ static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint6
     for (uint32_t i = 0; i < k; ++i) sum += weights[i];
     if (!(sum > 0)) sum = 1;
 
-    sp_u128 total = 0;
+    sp_u128 total = sp_u128_from(0), grid = sp_u128_from(s);
     long double scale = (long double)s / (long double)sum;
     for (uint32_t i = 0; i < k; ++i) {
         q[i] = floor_clamped((long double)weights[i] * scale, s, &remainder[i]);
-        total += q[i];
+        total = sp_u128_add_u64(total, q[i]);
     }
     order_by_remainder(remainder, k, order);
     /* The deficit is 0..k-1 for proper input; degenerate input (a sum of zero or rounding of
      * huge grids) is settled in bulk, never one grid step at a time. */
-    if (total < s) {
-        uint64_t deficit = (uint64_t)(s - total);
+    if (sp_u128_less(total, grid)) {
+        uint64_t deficit = sp_u128_low(sp_u128_sub(grid, total));
         for (uint32_t i = 0; i < k; ++i) q[i] += deficit / k;
         for (uint32_t t = 0; t < deficit % k; ++t) q[order[t]]++;
     }
-    for (uint32_t t = 0; total > s && t < k; ++t) { /* smallest remainders give back first */
+    for (uint32_t t = 0; sp_u128_less(grid, total) && t < k; ++t) { /* smallest remainders give back first */
         uint32_t slot = order[k - 1 - t];
-        uint64_t take = (uint64_t)(total - s) < q[slot] ? (uint64_t)(total - s) : q[slot];
+        sp_u128 excess = sp_u128_sub(total, grid); /* < 4s: the low half unless s is near 2^64 */
+        uint64_t take = sp_u128_high(excess) || sp_u128_low(excess) >= q[slot] ? q[slot] : sp_u128_low(excess);
         q[slot] -= take;
-        total -= take;
+        total = sp_u128_sub(total, sp_u128_from(take));
     }
     /* Keep descending order even where the rounding loops above had to wrap around. */
     for (uint32_t i = 1; i < k; ++i)
@@ -74,7 +71,9 @@ static void quantize_general(const float* weights, uint32_t k, uint64_t s, uint6
 
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
-    quantize_general(weights, k, s, q);
+    /* K = 2 with a constant k: what OSS codes of 51..64 bits (grids past 2^50) take per vertex */
+    if (k == 2) quantize_general(weights, 2, s, q);
+    else quantize_general(weights, k, s, q);
 }
 
 /* Stored components: Fixed stores q[0..k-1], Cube and POT q[1..k-1]. */

@@ -4,8 +4,11 @@
 
 #include "skinpack.h"
 
-/* 128-bit intermediates: the OSS closed forms overflow 64 bits for budgets near 64 bits. */
-typedef unsigned __int128 sp_u128;
+#include "cpu_features.h"
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+#include <emmintrin.h> /* sp_positive_or_zero */
+#endif
+#include "platform.h" /* SP_INLINE, sp_u128 (the OSS closed forms overflow 64 bits near 64-bit codes) */
 
 /* Float rounding of the input weights and of the decoded floats, added to every bound. */
 #define SP_FLOAT_SLACK 3.6e-7
@@ -13,23 +16,35 @@ typedef unsigned __int128 sp_u128;
 /* Largest-remainder rounding for any grid and any deficit (the slow, general path). */
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q);
 
+/* x > 0 ? x : 0 (NaN and -0 to +0) without a branch: zero weights are common and in no
+ * predictable order, and compilers keep the branch for the NaN semantics. MAXSD returns its
+ * second operand unless the first is greater, which is exactly this. */
+SP_INLINE double sp_positive_or_zero(double x)
+{
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+    return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(x), _mm_setzero_pd()));
+#else
+    return x > 0 ? x : 0;
+#endif
+}
+
 /*
  * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s.
  * Inlined so that callers with a constant k get unrolled, branch-free code: for grids below
  * 2^50 (double is exact enough) floor by conversion, then add one to the d largest remainders
  * chosen by rank instead of by sorting.
  */
-static inline __attribute__((always_inline)) void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s,
-                                                                   uint64_t* q)
+SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
+    k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
     if (s < ((uint64_t)1 << 50)) {
-        double remainder[SP_MAX_INFLUENCES], sum = 0;
-        for (uint32_t i = 0; i < k; ++i) sum += weights[i];
+        double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, sum = 0;
+        SP_UNROLL for (uint32_t i = 0; i < k; ++i) sum += weights[i];
         double scale = (double)s / sum;
         int64_t deficit = (int64_t)s;
-        for (uint32_t i = 0; i < k; ++i) {
+        SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
             double x = weights[i] * scale;
-            x = x > 0 ? x : 0;                 /* also maps NaN to 0 */
+            x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
             x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
             int64_t f = (int64_t)x;
             q[i] = (uint64_t)f;
@@ -40,17 +55,28 @@ static inline __attribute__((always_inline)) void sp_grid_quantize(const float* 
             /* rank[i]: components that win the bump before i (larger, or equal and lower);
              * each pair is compared once, a < b wins when its remainder is not smaller. */
             int64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            for (uint32_t a = 0; a < k; ++a)
-                for (uint32_t b = a + 1; b < k; ++b) {
+            SP_UNROLL for (uint32_t a = 0; a < k; ++a)
+                SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
                     int64_t a_wins = remainder[a] >= remainder[b];
                     rank[b] += a_wins;
                     rank[a] += 1 - a_wins;
                 }
-            for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
+            SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
             return;
         }
     }
     sp_grid_quantize_general(weights, k, s, q);
+}
+
+/* How many leading slots of grid point q carry weight: one past the last non-zero one, so that
+ * every slot from there on is zero (don't-care for the tuple table). For the sorted grids that
+ * is also the first zero slot. */
+static inline uint8_t sp_grid_significant(const uint64_t* q, uint32_t k)
+{
+    uint8_t count = 1;
+    SP_UNROLL for (uint32_t i = 1; i < k; ++i)
+        if (q[i] > 0) count = (uint8_t)(i + 1);
+    return count;
 }
 
 /* Fixed/Cube/POT: pack and unpack the integer grid coordinates q[0..k-1] (q[0] = largest). */
@@ -61,36 +87,52 @@ void sp_grid_unpack(const sp_codec* codec, uint64_t code, uint64_t* q);
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q);
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q);
 
-/* Instruction sets of the batch paths, in order. The public batch functions use the widest the
- * CPU has; the *_isa forms take a cap so tests can check every path the CPU has against the
- * scalar code (an argument, not a setting: the library keeps no state). */
-typedef enum { SP_OSS_ISA_SCALAR, SP_OSS_ISA_AVX2, SP_OSS_ISA_AVX512 } sp_oss_isa;
-
+/* The batch forms with a cap on the vector path (SP_ISA_SCALAR: none), so one test binary
+ * checks every path the CPU has against the scalar code; the public forms pass SP_ISA_AVX512. */
 sp_result sp_encode_weights_batch_isa(const sp_codec* codec, const float* weights, size_t vertex_count,
-                                      uint64_t* codes, uint8_t* significant, sp_oss_isa widest);
+                                      uint64_t* codes, uint8_t* significant, sp_isa widest);
 sp_result sp_decode_weights_batch_isa(const sp_codec* codec, const uint64_t* codes, size_t vertex_count,
-                                      float* weights, size_t* error_vertex, sp_oss_isa widest);
+                                      float* weights, size_t* error_vertex, sp_isa widest);
 
-/* OSS batch fast paths (codec_oss_batch.c): encode or decode a prefix of the vertices with
- * vector code where the CPU, the cap and the codec allow it, bit-identical to the scalar path;
- * return how many leading vertices were done (0 when not applicable). Decode stops before a
- * block holding a code above max_code, so the scalar loop reports it. */
+/* OSS batch dispatch (codec_oss_batch.c): encode or decode a prefix of the vertices with vector
+ * code where the CPU, the cap and the codec allow it, bit-identical to the scalar path; return
+ * how many leading vertices were done (0 when not applicable). Decode stops before a block
+ * holding a code above max_code, so the scalar loop reports it. */
 size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                           uint8_t* significant, sp_oss_isa widest);
+                           uint8_t* significant, sp_isa widest);
 size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
-                           sp_oss_isa widest);
+                           sp_isa widest);
+/* Whether the vector paths are exact for this codec (OSS, K = 2..4, N in range). */
+int sp_oss_batch_supported(const sp_codec* codec);
 
-/* The scalar encode of one vertex (grid rounding, significant count, OSS index): what vector
- * lanes that cannot prove themselves exact fall back to. significant may be NULL. */
-uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant);
-
-/* The AVX-512 batch paths (codec_oss_batch_avx512.c), blocks of 8 vertices, same contract as
- * the functions above for a codec they support; call only where sp_oss_has_avx512(). */
+/* The per-ISA paths (codec_oss_batch_avx2.c: blocks of 4; codec_oss_batch_avx512.c: blocks of
+ * 8), same contract; call only where sp_cpu_isa() has the ISA and the codec is supported. */
+size_t sp_oss_encode_avx2(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                          uint8_t* significant);
+size_t sp_oss_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
 size_t sp_oss_encode_avx512(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                             uint8_t* significant);
 size_t sp_oss_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
-int sp_oss_has_avx512(void);
 
+/* The scalar OSS encode (grid rounding, significant count, index; significant may be NULL) and
+ * decode (codec_oss.c) of one vertex: what the batch loops and the vector lanes that cannot
+ * prove themselves exact use. */
+uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant);
+/* The scalar OSS encode of vertices first..count-1 (K = 2..4; significant may be NULL), the
+ * rounding and index unrolled per K: what the batch encode runs after the vector prefix. */
+void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
+                          uint8_t* significant);
+/* The scalar OSS decode of codes first..count-1 (K = 2..4), inlined per K: returns the index of
+ * the first code past the codec's range (weights untouched from there), count if none. */
+size_t sp_oss_decode_scalar(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count, float* weights);
+void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights);
+
+/* Grid coordinates to weights, q[i] / s rounded once to float: every decoder's last step. */
+static inline void sp_grid_to_weights(const uint64_t* q, uint32_t k, uint64_t scale, float* weights)
+{
+    double inverse = 1.0 / (double)scale;
+    for (uint32_t i = 0; i < k; ++i) weights[i] = (float)((double)q[i] * inverse);
+}
 
 /* Any AABB works on floats directly (its axes do not share a grid). */
 uint64_t sp_any_encode(const sp_codec* codec, const float* weights);

@@ -12,10 +12,16 @@
 
 #include "codec_internal.h"
 
-/* Below this N every closed form fits in 64 bits (u(k) < 3N^3), so the fast path is exact. */
+/* Below OSS_SMALL_N the decoder's 64-bit root arguments are exact (8(N + 1)^3 < 2^64). Below
+ * OSS_ROW64_N and OSS_LAYER64_N the closed forms' numerators fit in 64 bits, so the 64-bit forms
+ * are exact: 4jN + 2j + 1 < 2^62 + 2^31 for rows j, N < 2^30; 3Nk(N - 2k + 3) <= 3N^3/8 and
+ * k(4k^2 - 9k + 6) < 4k^3 for layers k <= (N + 1)/2, below 2^63 for N < 2^21. */
 #define OSS_SMALL_N ((uint64_t)1 << 20)
+#define OSS_ROW64_N ((uint64_t)1 << 30)
+#define OSS_LAYER64_N ((uint64_t)1 << 21)
 
-/* 64-bit forms for N < OSS_SMALL_N, inlined into the encode and decode paths. */
+/* 64-bit forms for N below OSS_ROW64_N and OSS_LAYER64_N, inlined into the encode and decode
+ * paths. */
 static inline uint64_t row_base_small(uint64_t n, uint64_t j)
 {
     return (4 * j * n + 2 * j + 1 - 3 * j * j) / 4;
@@ -26,26 +32,47 @@ static inline uint64_t layer_base_small(uint64_t n, uint64_t k)
     return (3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9;
 }
 
+/* floor(a / d) for a small constant d and a quotient below 2^64, without a 128-bit division:
+ * with a = h 2^64 + l and 2^64 = d Q + r, a / d = h Q + floor(l / d) + floor((h r + l mod d) / d). */
+SP_INLINE uint64_t u128_div_small(sp_u128 a, uint64_t d)
+{
+    uint64_t q = UINT64_MAX / d, r = UINT64_MAX % d + 1;
+    if (r == d) q += 1, r = 0;
+    uint64_t h = sp_u128_high(a), l = sp_u128_low(a);
+    return h * q + l / d + (h * r + l % d) / d;
+}
+
+/* 9 u(k) + (9 u(k)'s remainder): 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 in 128 bits,
+ * k <= (N + 1)/2 (so N - 2k + 3 > 0; 4k^2 - 9k + 6 > 0 for every k). */
+static sp_u128 layer_numerator(uint64_t n, uint64_t k)
+{
+    sp_u128 nn = sp_u128_from(n), kk = sp_u128_from(k);
+    sp_u128 width = sp_u128_sub(sp_u128_add_u64(nn, 3), sp_u128_mul_u64(kk, 2)); /* N - 2k + 3 */
+    sp_u128 outer = sp_u128_mul(sp_u128_mul_u64(sp_u128_mul(nn, kk), 3), width);
+    sp_u128 inner = sp_u128_add_u64(sp_u128_mul(sp_u128_sub(sp_u128_mul_u64(kk, 4), sp_u128_from(9)), kk), 6);
+    return sp_u128_add_u64(sp_u128_add(outer, sp_u128_mul(kk, inner)), 2);
+}
+
 uint64_t sp_oss_row_base(uint64_t n, uint64_t j)
 {
     /* floor((-3j^2 + 2j + 4jN + 1) / 4); the numerator is positive for rows inside the triangle. */
-    if (n < OSS_SMALL_N && j < OSS_SMALL_N) return row_base_small(n, j);
-    sp_u128 jj = j, nn = n;
-    return (uint64_t)((4 * jj * nn + 2 * jj + 1 - 3 * jj * jj) / 4);
+    if (n < OSS_ROW64_N && j < OSS_ROW64_N) return row_base_small(n, j);
+    /* (4N + 2 - 3j) j + 1, positive inside the triangle */
+    sp_u128 slope = sp_u128_sub(sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 4), 2), sp_u128_mul_u64(sp_u128_from(j), 3));
+    sp_u128 numerator = sp_u128_add_u64(sp_u128_mul_u64(slope, j), 1);
+    return u128_div_small(numerator, 4);
 }
 
 uint64_t sp_oss_triangle_count(uint64_t n)
 {
-    sp_u128 nn = n;
-    return (uint64_t)((nn * nn + nn + 1) / 3);
+    return sp_u128_low(sp_oss_code_count(n, 3));
 }
 
 uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
-    if (n < OSS_SMALL_N) return layer_base_small(n, k);
-    sp_u128 nn = n, kk = k;
-    return (uint64_t)((3 * nn * kk * (nn - 2 * kk + 3) + kk * (4 * kk * kk - 9 * kk + 6) + 2) / 9);
+    if (n < OSS_LAYER64_N) return layer_base_small(n, k);
+    return u128_div_small(layer_numerator(n, k), 9);
 }
 
 uint64_t sp_oss_tetrahedron_count(uint64_t n)
@@ -55,15 +82,31 @@ uint64_t sp_oss_tetrahedron_count(uint64_t n)
 
 sp_u128 sp_oss_code_count(uint64_t n, uint32_t k)
 {
-    sp_u128 nn = n;
     switch (k) {
-    case 1: return 1;
-    case 2: return nn;
-    case 3: return (nn * nn + nn + 1) / 3;
+    case 1: return sp_u128_from(1);
+    case 2: return sp_u128_from(n);
+    case 3: { /* (N^2 + N + 1) / 3 */
+        sp_u128 nn = sp_u128_from(n);
+        return sp_u128_div_u64(sp_u128_add_u64(sp_u128_mul(nn, sp_u128_add_u64(nn, 1)), 1), 3);
+    }
+    case 4: /* u((N+1)/2), whose numerator fits 128 bits for N < 2^42, far past 64-bit codes */
+        return n < ((uint64_t)1 << 42) ? sp_u128_div_u64(layer_numerator(n, n / 2 + (n & 1)), 9) : sp_u128_from(0);
+    default: return sp_u128_from(0);
+    }
+}
+
+/* The index of grid point q, inlined into the batch encoder below with a constant k: the 64-bit
+ * closed forms wherever they are exact, the 128-bit ones (no 128-bit division) past them. */
+SP_INLINE uint64_t oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
+{
+    switch (k) {
+    case 2: return q[1];
+    case 3: return (n < OSS_ROW64_N ? row_base_small(n, q[2]) : sp_oss_row_base(n, q[2])) + (q[1] - q[2]);
     case 4: {
-        /* u((N+1)/2) in 128 bits: N up to ~2^43 before this overflows, far past 64-bit codes. */
-        sp_u128 kk = (nn + 1) / 2;
-        return (3 * nn * kk * (nn - 2 * kk + 3) + kk * (4 * kk * kk - 9 * kk + 6) + 2) / 9;
+        uint64_t layer = q[3], bottom = n - 2 * layer, row = q[2] - q[3];
+        uint64_t layer_base = n < OSS_LAYER64_N ? layer_base_small(n, layer) : sp_oss_layer_base(n, layer);
+        uint64_t row_base = n < OSS_ROW64_N ? row_base_small(bottom, row) : sp_oss_row_base(bottom, row);
+        return layer_base + row_base + (q[1] - q[2]);
     }
     default: return 0;
     }
@@ -71,111 +114,200 @@ sp_u128 sp_oss_code_count(uint64_t n, uint32_t k)
 
 uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 {
-    if (n < OSS_SMALL_N && k == 4) {
-        uint64_t layer = q[3];
-        return layer_base_small(n, layer) + row_base_small(n - 2 * layer, q[2] - q[3]) + (q[1] - q[2]);
+    return oss_pack(n, k, q);
+}
+
+/* One vertex after another with k constant, so the rounding and the index unroll into
+ * straight-line code with q in registers. */
+SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                              uint64_t* codes, uint8_t* significant, uint32_t k)
+{
+    uint64_t n = codec->n, scale = codec->scale;
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+        sp_grid_quantize(weights + v * k, k, scale, q);
+        if (significant) significant[v] = sp_grid_significant(q, k);
+        codes[v] = oss_pack(n, k, q);
     }
-    switch (k) {
-    case 2: return q[1];
-    case 3: return sp_oss_row_base(n, q[2]) + (q[1] - q[2]);
-    case 4: {
-        uint64_t layer = q[3];
-        return sp_oss_layer_base(n, layer) + sp_oss_row_base(n - 2 * layer, q[2] - q[3]) + (q[1] - q[2]);
+}
+
+void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
+                          uint8_t* significant)
+{
+    switch (codec->influences) {
+    case 2: oss_encode_run(codec, weights, first, count, codes, significant, 2); break;
+    case 3: oss_encode_run(codec, weights, first, count, codes, significant, 3); break;
+    case 4: oss_encode_run(codec, weights, first, count, codes, significant, 4); break;
+    default: break;
     }
-    default: return 0;
-    }
+}
+
+/* The largest index i < count with base_of(n, i) <= w, from an estimate that is it but for
+ * rounding: clamped, then one check each way (inlined with base_of, so no indirect call). */
+SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, uint64_t w,
+                                   uint64_t (*base_of)(uint64_t, uint64_t), uint64_t* base)
+{
+    uint64_t i = estimate <= 0 ? 0 : (uint64_t)estimate;
+    if (i >= count) i = count - 1;
+    uint64_t at = base_of(n, i);
+    while (i > 0 && at > w) at = base_of(n, --i);
+    for (uint64_t next; i + 1 < count && (next = base_of(n, i + 1)) <= w; ++i) at = next;
+    *base = at;
+    return i;
 }
 
 /* Largest row j with s_N(j) <= w. Estimate from the mirrored square root:
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
- * relevant root is the one left of the apex.) */
-static uint64_t oss_find_row(uint64_t n, uint64_t w)
+ * relevant root is the one left of the apex.) For N < OSS_SMALL_N, inlined into the batch
+ * decoder (everything but w is the same for every code of a layer size). */
+SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
+{
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1;
+    /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
+     * arithmetic, so the checks below take one step, not two */
+    double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
+    double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    return settle_estimate(estimate, rows, n, w, row_base_small, base);
+}
+
+/* The same for N >= OSS_SMALL_N, with the root's argument in 128 bits. */
+static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
 {
     uint64_t rows = (2 * n + 1) / 3;
-    double mirrored, apex;
-    if (n < OSS_SMALL_N) {
-        uint64_t two_n1 = 2 * n + 1;
-        mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w);
-        apex = (double)two_n1;
-    } else {
-        sp_u128 two_n1 = 2 * (sp_u128)n + 1;
-        mirrored = (double)(two_n1 * two_n1 + 3 - 12 * (sp_u128)w);
-        apex = (double)two_n1;
-    }
-    double estimate = (apex - sqrt(mirrored)) / 3.0;
+    /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
+    sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
+    sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
+    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
+    double estimate = (sp_u128_to_double(two_n1) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
     uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (j >= rows) j = rows - 1;
-    if (n < OSS_SMALL_N) {
-        while (j + 1 < rows && row_base_small(n, j + 1) <= w) ++j;
-        while (j > 0 && row_base_small(n, j) > w) --j;
-        return j;
-    }
     while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
     while (j > 0 && sp_oss_row_base(n, j) > w) --j;
+    *base = sp_oss_row_base(n, j);
     return j;
 }
 
-/* Largest layer k with u(k) <= code. With M = N + 1, 72(u~((N+1)/2) - code) equals
- * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
- * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
-/* Cube root of x >= 1 to ~1e-12: exponent/3 bit trick, then three Newton steps. The layer
- * search below only needs the estimate to within a layer, and libm's cbrt costs ~4x more. */
-static inline double cube_root(double x)
+/*
+ * cbrt(x) + 1/cbrt(x) for x >= 1 to ~1e-8 without a division or square root, as the AVX2 path
+ * computes it (codec_oss_batch_avx2.c, root_start/root_finish): z ~ x^(-1/3) from the float
+ * exponent/3 bit trick and a third-order step, then c + z with c = x z^2 corrected by one
+ * Newton step's first-order term.
+ */
+static inline double cube_root_sum(double x)
 {
-    uint64_t bits;
-    double y;
-    memcpy(&bits, &x, sizeof(bits));
-    bits = bits / 3 + 0x2A9F7893782DA1CEull;
-    memcpy(&y, &bits, sizeof(y));
-    for (int i = 0; i < 3; ++i) y -= (y * y * y - x) / (3 * y * y);
-    return y;
+    float xf = (float)x, zf;
+    int32_t bits;
+    memcpy(&bits, &xf, sizeof(bits));
+    bits = 1419916032 - (int32_t)((float)bits * (1.0f / 3.0f));
+    memcpy(&zf, &bits, sizeof(zf));
+    float r = 1.0f - (xf * zf) * (zf * zf);
+    zf += (zf * r) * (r * (2.0f / 9.0f) + 1.0f / 3.0f);
+    double z = zf, xz = x * z, c = xz * z, rd = 1.0 - xz * (z * z);
+    return (c + z) + rd * (c * (2.0 / 3.0) + z * (1.0 / 3.0));
 }
 
-static uint64_t oss_find_layer(uint64_t n, uint64_t code)
+/* Largest layer k with u(k) <= code for N < OSS_SMALL_N. The estimate of the vector paths:
+ * (2N + 3 - t) / 4 with t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code
+ * for code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one
+ * check each way, no square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
+SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
+{
+    uint64_t layers = (n + 1) / 2;
+    uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
+    double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
+    double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
+    return settle_estimate(estimate, layers, n, code, layer_base_small, base);
+}
+
+/* The same for N >= OSS_SMALL_N. With M = N + 1, 72(u~((N+1)/2) - code) equals
+ * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
+ * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
+static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
 {
     uint64_t layers = (n + 1) / 2;
     double v;
-    if (n < OSS_SMALL_N) { /* everything below 2^63: no 128-bit conversions */
-        uint64_t m = n + 1;
-        v = (double)(int64_t)(4 * m * m * m + 6 * m * m + 16 - 72 * code);
-    } else {
-        sp_u128 m = (sp_u128)n + 1;
-        v = (double)(4 * m * m * m + 6 * m * m + 16 - 72 * (sp_u128)code);
+    { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
+        sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
+        sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 4), sp_u128_mul_u64(m2, 6));
+        v = sp_u128_to_double(sp_u128_sub(sp_u128_add_u64(cubic, 16), sp_u128_mul_u64(sp_u128_from(code), 72)));
     }
     double root = v > 2 ? sqrt(v * (v - 2)) : 0;
-    double c = n < OSS_SMALL_N ? cube_root(v - 1 + root) : cbrt(v - 1 + root);
+    double c = cbrt(v - 1 + root);
     if (c < 1) c = 1;
     double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
     uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (k >= layers) k = layers - 1;
-    if (n < OSS_SMALL_N) {
-        while (k + 1 < layers && layer_base_small(n, k + 1) <= code) ++k;
-        while (k > 0 && layer_base_small(n, k) > code) --k;
-        return k;
-    }
     while (k + 1 < layers && sp_oss_layer_base(n, k + 1) <= code) ++k;
     while (k > 0 && sp_oss_layer_base(n, k) > code) --k;
+    *base = sp_oss_layer_base(n, k);
     return k;
 }
 
-void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+/* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
+SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
 {
-    uint64_t layer = 0, row, rest = code, bottom = n;
+    uint64_t layer = 0, row, rest = code, bottom = n, base;
     if (k == 2) {
         q[1] = code;
         q[0] = 2 * (n - 1) - code;
         return;
     }
     if (k == 4) {
-        layer = oss_find_layer(n, code);
-        rest -= sp_oss_layer_base(n, layer); /* inlined small form for small N */
+        layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
+        rest -= base;
         bottom = n - 2 * layer;
     }
-    row = oss_find_row(bottom, rest);
-    uint64_t i = rest - sp_oss_row_base(bottom, row);
+    row = bottom < OSS_SMALL_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
+    uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;
     q[1] = i + row + layer;
     q[0] = 2 * (n - 1) - q[1] - q[2] - (k == 4 ? q[3] : 0);
+}
+
+void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+{
+    oss_unpack(n, k, code, q);
+}
+
+/* Decodes codes first..count-1 with k constant; stops at a code past the codec's range. */
+SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count,
+                                float* weights, uint32_t k)
+{
+    uint64_t n = codec->n, max_code = codec->max_code;
+    double inverse = 1.0 / (double)codec->scale; /* as sp_grid_to_weights */
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+        if (codes[v] > max_code) return v;
+        oss_unpack(n, k, codes[v], q);
+        for (uint32_t i = 0; i < k; ++i) weights[v * k + i] = (float)((double)q[i] * inverse);
+    }
+    return count;
+}
+
+size_t sp_oss_decode_scalar(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count, float* weights)
+{
+    switch (codec->influences) {
+    case 2: return oss_decode_run(codec, codes, first, count, weights, 2);
+    case 3: return oss_decode_run(codec, codes, first, count, weights, 3);
+    case 4: return oss_decode_run(codec, codes, first, count, weights, 4);
+    default: return first;
+    }
+}
+
+uint64_t sp_oss_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
+{
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    uint32_t k = codec->influences;
+    sp_grid_quantize(weights, k, codec->scale, q);
+    if (significant) *significant = sp_grid_significant(q, k);
+    return sp_oss_pack(codec->n, k, q);
+}
+
+void sp_oss_decode_one(const sp_codec* codec, uint64_t code, float* weights)
+{
+    uint64_t q[SP_MAX_INFLUENCES] = {0};
+    sp_oss_unpack(codec->n, codec->influences, code, q);
+    sp_grid_to_weights(q, codec->influences, codec->scale, weights);
 }

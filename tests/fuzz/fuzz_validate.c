@@ -63,8 +63,8 @@ static void check_other_decoders(const sp_packed_primitive* prim, const sp_valid
         abort();
     if (sp_unpack_vertices(prim->words, n, (uint32_t)prim->params.tuple_bits, codec->bits, tuples, codes, NULL) != SP_OK)
         abort();
-    for (int isa = SP_OSS_ISA_SCALAR; isa <= SP_OSS_ISA_AVX512; ++isa) {
-        if (sp_decode_weights_batch_isa(codec, codes, n, other_weights, NULL, (sp_oss_isa)isa) != SP_OK) abort();
+    for (int isa = SP_ISA_SCALAR; isa <= SP_ISA_AVX512; ++isa) {
+        if (sp_decode_weights_batch_isa(codec, codes, n, other_weights, NULL, (sp_isa)isa) != SP_OK) abort();
         if (memcmp(other_weights, weights, n * k * sizeof(float))) abort();
     }
     free(other_joints);

@@ -314,6 +314,45 @@ static void add_code(const sp_codec* codec, uint64_t* codes, size_t* count, u128
     if (code <= codec->max_code && code_is_valid(codec, (uint64_t)code)) codes[(*count)++] = (uint64_t)code;
 }
 
+/* The 64-bit decoder's 32-bit row step (K = 4 while S(N) < 2^32, shaders/skinpack_decode.glsl)
+ * at its limit N = 113511 and just past it (the 64-bit row step): the row boundaries of the
+ * first layers, whose triangles come closest to 2^32 codes, the last codes, and random ones. */
+static size_t check_in_layer_rows(harness* h)
+{
+    enum { MAX_CODES = 1024 };
+    static const uint64_t limit = 113511; /* SP_OSS_LAYER32_MAX_N: the largest N with S(N) < 2^32 */
+    uint64_t codes[MAX_CODES];
+    if (sp_oss_triangle_count(limit) > UINT32_MAX || sp_oss_triangle_count(limit + 1) <= UINT32_MAX)
+        fail_check(h, "S(%llu) is not the last triangle count below 2^32", (unsigned long long)limit);
+    for (uint64_t n = limit; n <= limit + 1; ++n) {
+        sp_codec codec;
+        size_t count = 0;
+        configure(h, SP_METHOD_OSS, 4, n, NULL, &codec);
+        for (uint64_t layer = 0; layer < 3; ++layer) {
+            uint64_t bottom = n - 2 * layer, rows = (2 * bottom + 1) / 3, base = sp_oss_layer_base(n, layer);
+            for (int i = 0; i < 60; ++i) {
+                uint64_t row = i < 20 ? rows - 1 - (uint64_t)i : (i < 30 ? (uint64_t)i - 20 : random_next() % rows);
+                u128 start = (u128)base + sp_oss_row_base(bottom, row);
+                add_code(&codec, codes, &count, start);
+                add_code(&codec, codes, &count, start + 1);
+                if (start > 0) add_code(&codec, codes, &count, start - 1);
+            }
+        }
+        /* past the limit, layer 0's in-layer indices cross 2^32: the codes and rows around it */
+        uint64_t crossing = 0, rows0 = (2 * n + 1) / 3;
+        while (crossing + 1 < rows0 && sp_oss_row_base(n, crossing + 1) <= UINT32_MAX) ++crossing;
+        for (uint64_t row = crossing; row < crossing + 3 && row < rows0; ++row) {
+            add_code(&codec, codes, &count, sp_oss_row_base(n, row));
+            add_code(&codec, codes, &count, (u128)sp_oss_row_base(n, row) + 1);
+        }
+        for (uint64_t d = 0; d < 8; ++d) add_code(&codec, codes, &count, (u128)UINT32_MAX - 3 + d);
+        for (uint64_t back = 0; back < 32; ++back) add_code(&codec, codes, &count, codec.max_code - back);
+        for (int i = 0; i < 256; ++i) add_code(&codec, codes, &count, random_next() % (codec.max_code + 1));
+        decode_and_check(h, &codec, codes, count, n == limit ? "in-layer rows limit" : "past in-layer rows");
+    }
+    return 2;
+}
+
 static void test_widths(harness* h)
 {
     enum { RANDOM_CODES = 256, MAX_CODES = 1024 };
@@ -374,6 +413,7 @@ static void test_widths(harness* h)
         if (SP_GPU_CODEC_IS_NARROW(gpu)) fail_check(h, "OSS K=%u N=%llu should take the 64-bit decoder", k, (unsigned long long)n + 1);
         configurations += 2;
     }
+    configurations += check_in_layer_rows(h);
     printf("widths: %zu configurations\n", configurations);
 }
 
@@ -744,8 +784,9 @@ static void test_mesh(harness* h, const char* path)
         gpu = gpu_skin(h, specialised_pipeline, &mesh, &gpu_codec, words, n * skin.words_per_vertex, lut_bytes,
                        lut_entries * skin.joint_bytes, NULL, 0);
         compare_positions(h, gpu, reference_decoded, n, tolerance,
-                          spec.decoder == SP_SPEC_DECODER_NARROW ? "  same, specialised 32-bit decoder"
-                                                                 : "  same, specialised 64-bit decoder");
+                          spec.decoder == SP_SPEC_DECODER_NARROW        ? "  same, specialised 32-bit decoder"
+                          : spec.decoder == SP_SPEC_DECODER_WIDE_ROWS32 ? "  same, specialised 64-bit layer / 32-bit row decoder"
+                                                                        : "  same, specialised 64-bit decoder");
         vkDestroyPipeline(h->ctx.device, specialised_pipeline, NULL);
 
         /* Quantisation effect vs the original weights, bounded per vertex by

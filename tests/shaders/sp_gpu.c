@@ -44,7 +44,9 @@ vkx_specialization sp_gpu_specialization(uint32_t vertex_format, const SpGpuCode
     if (codec && vertex_format == SP_VERTEX_FORMAT_PACKED) {
         spec.method = codec->config.x;
         spec.influences = codec->config.y;
-        spec.decoder = SP_GPU_CODEC_IS_NARROW(*codec) ? SP_SPEC_DECODER_NARROW : SP_SPEC_DECODER_WIDE;
+        spec.decoder = SP_GPU_CODEC_IS_NARROW(*codec) ? SP_SPEC_DECODER_NARROW
+                       : SP_GPU_CODEC_ROWS32(*codec)  ? SP_SPEC_DECODER_WIDE_ROWS32
+                                                      : SP_SPEC_DECODER_WIDE;
     }
     return spec;
 }

@@ -13,7 +13,7 @@
 #include "skinpack.h"
 
 /* The widest vector path the batch calls under test may take (main walks AVX-512, then AVX2). */
-static sp_oss_isa widest = SP_OSS_ISA_AVX512;
+static sp_isa widest = SP_ISA_AVX512;
 #define encode_batch(c, w, n, codes, sig) sp_encode_weights_batch_isa(c, w, n, codes, sig, widest)
 #define decode_batch(c, codes, n, w, bad) sp_decode_weights_batch_isa(c, codes, n, w, bad, widest)
 
@@ -126,7 +126,7 @@ static void random_tuple(uint32_t k, uint64_t s, float* w)
 /* Millions of random tuples on the bench budgets and at the edges of the vector path. */
 static void random_tuples(void)
 {
-    static const uint32_t budgets[] = {8, 16, 22, 26, 30, 38, 44, 52, 64};
+    static const uint32_t budgets[] = {8, 16, 22, 26, 30, 38, 44, 45, 46, 52, 64};
     size_t count = 300000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -148,7 +148,7 @@ static void random_tuples(void)
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 23}, {4, (uint64_t)1 << 15}};
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -180,7 +180,7 @@ static void range_edges(void)
  * there for large N), each lane decoded or redone as the scalar code decodes it. */
 static void estimate_boundaries(void)
 {
-    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}};
+    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
     for (size_t e = 0; e < sizeof(cases) / sizeof(cases[0]); ++e) {
         sp_codec c;
         uint32_t k = cases[e].k;
@@ -275,7 +275,7 @@ static void invalid_codes(void)
 
 /* The vertices each path takes in a batch of 23 (the scalar loop does the rest): a path that
  * silently did nothing would pass every comparison above. */
-static void path_coverage(sp_oss_isa isa)
+static void path_coverage(sp_isa isa)
 {
     float w[23 * 4];
     uint64_t codes[23];
@@ -284,20 +284,38 @@ static void path_coverage(sp_oss_isa isa)
         CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
         for (size_t v = 0; v < 23; ++v) random_tuple(k, c.scale, w + v * k);
         size_t expected = 0;
-#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
-        if (isa >= SP_OSS_ISA_AVX512 && sp_oss_has_avx512()) expected = 16 + 4; /* two blocks of 8, one of 4 */
-        else if (isa >= SP_OSS_ISA_AVX2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) expected = 20;
-#endif
+        sp_isa cpu = sp_cpu_isa();
+        if (isa >= SP_ISA_AVX512 && cpu >= SP_ISA_AVX512) expected = 16 + 4; /* two blocks of 8, one of 4 */
+        else if (isa >= SP_ISA_AVX2 && cpu >= SP_ISA_AVX2) expected = 20;
         CHECK_MSG(sp_oss_encode_batch(&c, w, 23, codes, NULL, isa) == expected, "K=%u isa %d encode prefix", k, (int)isa);
+        /* valid codes (an unsorted random tuple may have encoded past max_code) */
+        for (size_t v = 0; v < 23; ++v) codes[v] = rng_next() % (c.max_code + 1);
         CHECK_MSG(sp_oss_decode_batch(&c, codes, 23, w, isa) == expected, "K=%u isa %d decode prefix", k, (int)isa);
     }
 }
 
+/* The cached CPU answer is the detected one and agrees with the compiler's own feature test
+ * (which also checks the OS state): a wrong answer would run an ISA the CPU lacks, or skip
+ * every vector path and let the comparisons above pass on scalar code alone. */
+static void cpu_features(void)
+{
+    sp_isa cached = sp_cpu_isa();
+    CHECK(cached == sp_cpu_isa_detect());
+    CHECK(sp_cpu_isa() == cached);
+#if (defined(__x86_64__) || defined(__i386__)) && (defined(__GNUC__) || defined(__clang__))
+    int avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    int avx512 = avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                 __builtin_cpu_supports("avx512vl");
+    CHECK_MSG(cached == (avx512 ? SP_ISA_AVX512 : avx2 ? SP_ISA_AVX2 : SP_ISA_SCALAR), "sp_cpu_isa %d", (int)cached);
+#endif
+}
+
 int main(void)
 {
+    cpu_features();
     /* AVX-512 (with AVX2 on its tail) first, then AVX2 alone; each falls to the next on CPUs
      * without it, so the checks then merely repeat. */
-    static const sp_oss_isa paths[] = {SP_OSS_ISA_AVX512, SP_OSS_ISA_AVX2};
+    static const sp_isa paths[] = {SP_ISA_AVX512, SP_ISA_AVX2};
     for (size_t p = 0; p < sizeof(paths) / sizeof(paths[0]); ++p) {
         widest = paths[p];
         path_coverage(paths[p]);

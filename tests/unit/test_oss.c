@@ -30,7 +30,7 @@ static void exhaustive_identity(void)
 {
     for (uint32_t k = 2; k <= 4; ++k)
         for (uint64_t n = 2; n <= (k == 2 ? 400u : (k == 3 ? 300u : 200u)); ++n) {
-            uint64_t count = (uint64_t)sp_oss_code_count(n, k), s = 2 * (n - 1);
+            uint64_t count = sp_u128_low(sp_oss_code_count(n, k)), s = 2 * (n - 1);
             for (uint64_t code = 0; code < count; ++code) {
                 uint64_t q[4] = {0}, sum = 0;
                 sp_oss_unpack(n, k, code, q);

@@ -1,0 +1,326 @@
+/*
+ * The OSS block/chunk driver, written once over per-ISA primitives (internal; included by
+ * codec_oss_batch_avx2.c and codec_oss_batch_avx512.c, the way meshoptimizer's vertexcodec
+ * writes its SIMD group decoder per ISA and the driver once).
+ *
+ * Results are bit-identical to the scalar path (sp_grid_quantize + sp_oss_pack, and
+ * sp_oss_unpack + sp_grid_to_weights): the rounding runs in double lanes with the scalar's
+ * exact operation order, and the OSS index arithmetic runs in double lanes too, where every
+ * intermediate is an integer or a quarter small enough (codec_oss_batch.c) to be exact in any order (Horner forms,
+ * explicit FMAs). Decode's layer and row *estimates* differ from the scalar ones (no layer
+ * square root, no divisions, shifted arguments): exact integer checks decide every lane. A lane
+ * whose inputs leave that exact regime (odd weights, a code the estimate misses) is redone by
+ * the scalar code, so the vector code only ever has to be right where it claims to be.
+ *
+ * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN):
+ *   vec, mask          BLOCK double lanes and a lane mask; BLOCK, ENCODE_CHUNK, DECODE_CHUNK
+ *   simd_layout        whatever load/store need per K (permute indices), from layout_for(k)
+ *   v_splat v_zero v_add v_sub v_mul v_div v_sqrt v_max v_min v_floor v_trunc
+ *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
+ *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
+ *   load_weights, store_weights (AoS floats <-> K vectors), load_codes, store_codes (u64),
+ *   store_counts (lane values as bytes), codes_valid (every code <= max_code)
+ *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
+ * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
+ * they handled (whole blocks); the caller's scalar loop does the rest.
+ *
+ * Why stages: a block's whole encode or decode is one long dependency chain, and the core keeps
+ * only a few blocks' worth of waiting operations in flight, so the work runs in stages of short
+ * chains, each over all blocks of a chunk before the next: the blocks of one stage are
+ * independent, and the core overlaps them (K = 4 encode ~1.5x, decode ~1.1x on AVX2).
+ */
+
+/* s_B(j) = floor(((4B + 2 - 3j) j + 1) / 4) for rows inside the triangle (positive), as
+ * floor((B + 1/2 - 3j/4) j + 1/4): every exact intermediate is a multiple of 1/4 below 2^50, so
+ * each step, fused or not, is exact. */
+SP_INLINE SIMD_FN vec row_base(vec b, vec j)
+{
+    vec quarter = v_fnmadd(j, v_splat(0.75), v_add(b, v_splat(0.5))); /* (4B + 2 - 3j) / 4 */
+    return v_floor(v_fmadd(quarter, j, v_splat(0.25)));
+}
+
+/* u(k) = floor((3Nk(N - 2k + 3) + k((4k - 9)k + 6) + 2) / 9), for k <= (N + 1)/2, with the
+ * numerator a in Horner form ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2: integers below 2^50, so
+ * exact, and the last step adds 1/2 as well: a = 9m + r with 0 <= r < 9 puts (a + 1/2) / 9 at
+ * least 1/18 away from an integer, while the product with the rounded 1/9 is within
+ * (a/9) 2^-52 < 1/36 of it, so its floor is the exact quotient m. */
+SP_INLINE SIMD_FN vec layer_base(double n, vec k)
+{
+    vec a = v_fmadd(k, v_splat(4.0), v_splat(-(6 * n + 9)));
+    vec b = v_fmadd(a, k, v_splat(3 * n * n + 9 * n + 6));
+    return v_floor(v_mul(v_fmadd(b, k, v_splat(2.5)), v_splat(1.0 / 9.0)));
+}
+
+/* ---- encode ----------------------------------------------------------------------------- */
+
+/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain. */
+SP_INLINE SIMD_FN vec quantize_scale(const vec* w, uint32_t k, double s)
+{
+    vec sum = v_zero();
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) sum = v_add(sum, w[i]); /* 0 + w0 first: keeps -0 as the scalar does */
+    return v_div(v_splat(s), sum);
+}
+
+/* sp_grid_quantize's floors x = max(w s / sum, 0) -> q = trunc(x), remainder = x - q, same
+ * operations in the same order; returns the deficit s - sum of q. */
+SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
+{
+    vec deficit = v_splat(s);
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) {
+        vec x = v_max(v_mul(w[i], scale), v_zero()); /* max returns its second operand for NaN: x > 0 ? x : 0 */
+        q[i] = v_trunc(x);
+        remainder[i] = v_sub(x, q[i]);
+        deficit = v_sub(deficit, q[i]);
+    }
+    return deficit;
+}
+
+/*
+ * sp_grid_quantize's last step: the deficit goes, one each, to the components with the largest
+ * remainders (ties to the lower index), chosen by rank. Returns the lanes the fast path is exact
+ * for: a deficit in [0, k), where the scalar takes the same path. That also bounds every x by
+ * s + 1, so floors and deficit are exact: an x past that makes the deficit negative, and one
+ * past 2^53 (or infinite) keeps it so under rounding. Other lanes get some q: they are redone.
+ */
+SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remainder, vec* q)
+{
+    vec rank[SP_MAX_INFLUENCES], one = v_splat(1.0);
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) rank[i] = v_splat((double)(k - 1 - i)); /* every later slot beats i ... */
+    SP_UNROLL
+    for (uint32_t a = 0; a < k; ++a) { /* ... unless i wins against it; an earlier slot a beats b when it wins */
+        SP_UNROLL
+        for (uint32_t b = a + 1; b < k; ++b) {
+            mask a_wins = m_ge(remainder[a], remainder[b]);
+            rank[a] = v_add_where(rank[a], a_wins, v_splat(-1.0));
+            rank[b] = v_add_where(rank[b], a_wins, one);
+        }
+    }
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) q[i] = v_add_where(q[i], m_gt(deficit, rank[i]), one);
+    return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
+}
+
+/* sp_oss_pack on sorted lanes (the caller masks unsorted ones: the scalar wraps around there). */
+SP_INLINE SIMD_FN vec pack_block(const vec* q, uint32_t k, double n)
+{
+    if (k == 2) return q[1];
+    if (k == 3) return v_add(row_base(v_splat(n), q[2]), v_sub(q[1], q[2]));
+    vec layer = q[3], bottom = v_fnmadd(layer, v_splat(2.0), v_splat(n));
+    vec row = row_base(bottom, v_sub(q[2], q[3]));
+    return v_add(v_add(layer_base(n, layer), row), v_sub(q[1], q[2]));
+}
+
+/* Significant counts of sorted lanes: 1 + the non-zero components after the first. */
+SP_INLINE SIMD_FN void store_significant(const vec* q, uint32_t k, uint8_t* out)
+{
+    vec count = v_splat(1.0);
+    SP_UNROLL
+    for (uint32_t i = 1; i < k; ++i) count = v_add_where(count, m_gt(q[i], v_zero()), v_splat(1.0));
+    store_counts(count, out);
+}
+
+/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the quantisation's division, its floors,
+ * its rounding, the indices, and the scalar redo of the lanes the vector code cannot prove exact
+ * (a pass of its own: a call among the vector stages would clobber every vector register). */
+SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights, size_t blocks, uint64_t* codes,
+                                    uint8_t* significant, uint32_t k, const simd_layout* layout)
+{
+    double s = (double)codec->scale, n = (double)codec->n;
+    vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK], deficit[ENCODE_CHUNK];
+    vec q[ENCODE_CHUNK][SP_MAX_INFLUENCES], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
+    unsigned missed[ENCODE_CHUNK]; /* lanes as bits */
+    for (size_t b = 0; b < blocks; ++b) {
+        load_weights(weights + b * BLOCK * k, k, layout, w[b]);
+        scale[b] = quantize_scale(w[b], k, s);
+    }
+    for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
+    for (size_t b = 0; b < blocks; ++b) {
+        mask ok = quantize_round(k, deficit[b], remainder[b], q[b]);
+        SP_UNROLL
+        for (uint32_t i = 1; i < k; ++i) ok = m_and(ok, m_ge(q[b][i - 1], q[b][i]));
+        missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
+    }
+    for (size_t b = 0; b < blocks; ++b) {
+        store_codes(codes + b * BLOCK, pack_block(q[b], k, n));
+        if (significant) store_significant(q[b], k, significant + b * BLOCK);
+    }
+    for (size_t b = 0; b < blocks; ++b)
+        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
+}
+
+SP_INLINE SIMD_FN size_t encode_blocks(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                       uint8_t* significant, uint32_t k)
+{
+    simd_layout layout = layout_for(k);
+    size_t v = 0;
+    for (; v + ENCODE_CHUNK * BLOCK <= count; v += ENCODE_CHUNK * BLOCK)
+        encode_chunk(codec, weights + v * k, ENCODE_CHUNK, codes + v, significant ? significant + v : NULL, k, &layout);
+    size_t blocks = (count - v) / BLOCK;
+    if (blocks) encode_chunk(codec, weights + v * k, blocks, codes + v, significant ? significant + v : NULL, k, &layout);
+    return v + blocks * BLOCK;
+}
+
+SIMD_FN size_t SIMD_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                 uint8_t* significant)
+{
+    switch (codec->influences) { /* constant k: unrolled lanes */
+    case 2: return encode_blocks(codec, weights, count, codes, significant, 2);
+    case 3: return encode_blocks(codec, weights, count, codes, significant, 3);
+    default: return encode_blocks(codec, weights, count, codes, significant, 4);
+    }
+}
+
+/* ---- decode ----------------------------------------------------------------------------- */
+
+/*
+ * The layer: sp_oss_unpack's estimate (2N + 3 - t) / 4 with t = c + 1/c,
+ * c = cbrt(V - 1 + sqrt(V (V - 2))), for code + 17/18 instead of code, floored and clamped to
+ * the layers. V = 72 (u~(k0) - code) with k0 = (N + 1)/2 and u~ the unfloored u
+ * (u~(k) - u(k) in [0, 8/9]), which increases up to k0, so every code of layer k plus 17/18 lies
+ * strictly between u~(k) and u~(k + 1) (the same shift as the row estimate's 7/8) and in exact
+ * arithmetic the estimate is the layer; it also keeps V >= 4 for valid codes.
+ * c^3 + 1/c^3 = 2(V - 1) = x, so t is the root t >= 2 of t^3 - 3t = x, and cbrt(x) + 1/cbrt(x)
+ * is within c^-5/3 of it (below 1e-6 but for the last few codes, where x < 2000), which skips
+ * the scalar's square root; the ISA's root_start/root_finish compute it without a division.
+ * Codes within the estimate's error of a layer boundary land in the wrong layer, and the row
+ * check sends them to the scalar code.
+ */
+
+/* x = 2(V - 1) for code + 17/18: an integer below 2^53 (see BATCH_MAX_N4), so the fused product is exact. */
+SP_INLINE SIMD_FN vec layer_argument(double n, vec code)
+{
+    double m = n + 1;
+    return v_fnmadd(code, v_splat(144.0), v_splat(8 * m * m * m + 12 * m * m - 106));
+}
+
+/* floor(e) clamped to [0, top]; NaN becomes 0 (max returns its second operand). */
+SP_INLINE SIMD_FN vec clamp_floor(vec e, vec top)
+{
+    return v_min(v_max(v_floor(e), v_zero()), top);
+}
+
+SP_INLINE SIMD_FN vec layer_estimate(double n, vec t)
+{
+    vec estimate = v_fnmadd(t, v_splat(0.25), v_splat((2 * n + 3) / 4));
+    return clamp_floor(estimate, v_splat((double)(((uint64_t)n + 1) / 2 - 1)));
+}
+
+/* The row: the mirrored square root estimate for w + 7/8 instead of w in the triangle with
+ * B = `bottom` samples along its bottom edge, floored and clamped to j >= 0. s(j) = floor(s~(j))
+ * with s~(j) - s(j) in {0, 1/4, 1/2, 3/4}, so w + 7/8 lies strictly between s~(j) and
+ * s~(j + 1) for every w of row j, and in exact arithmetic the estimate is the row. With
+ * apex = 2B + 1, 12 (w + 7/8) = 12 w + 10.5: mirrored = apex^2 + 3 - 10.5 - 12 w. The correctly
+ * rounded sqrt keeps the rounding error far below the 1/8 margin up to the largest N. No clamp
+ * to the last row: the estimate is at most apex / 3 < rows + 1, and row_offset rejects
+ * j = rows (a row of no codes). */
+SP_INLINE SIMD_FN vec row_estimate(vec bottom, vec w)
+{
+    vec apex = v_fmadd(bottom, v_splat(2.0), v_splat(1.0));
+    vec mirrored = v_fnmadd(w, v_splat(12.0), v_fmsub(apex, apex, v_splat(7.5)));
+    vec estimate = v_mul(v_sub(apex, v_sqrt(mirrored)), v_splat(1.0 / 3.0));
+    return v_max(v_floor(estimate), v_zero());
+}
+
+/* i = w - s(j), and *ok the lanes where j is w's row, that is where i is in
+ * [0, floor((2B - 3j) / 2)), the length of row j (none for j >= rows): for integral i that is
+ * 0 <= i <= B - 1 - 3j/2. Exact: integers and halves below 2^50. */
+SP_INLINE SIMD_FN vec row_offset(vec bottom, vec j, vec w, mask* ok)
+{
+    vec i = v_sub(w, row_base(bottom, j));
+    vec last = v_fnmadd(j, v_splat(1.5), v_sub(bottom, v_splat(1.0)));
+    *ok = m_and(m_ge(i, v_zero()), m_ge(last, i));
+    return i;
+}
+
+/* sp_oss_unpack's sorted grid components for K = 3, 4 from the layer (0 for K = 3), row j and
+ * offset i: integers below 2^50, so exact in any order. */
+SP_INLINE SIMD_FN void unpacked_block(double n, uint32_t k, vec layer, vec row, vec i, vec* q)
+{
+    if (k == 4) q[3] = layer;
+    q[2] = v_add(row, layer);
+    q[1] = v_add(i, q[2]);
+    vec sum = v_add(q[1], q[2]);
+    q[0] = v_sub(v_splat(2 * (n - 1)), k == 4 ? v_add(sum, layer) : sum);
+}
+
+/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes <= max_code, in stages
+ * (the layer root's two halves, the row, the rest), then the scalar redo of the lanes it missed.
+ * Every array entry is written in a stage before a later one reads it.
+ *
+ * The layer needs no check of its own: with k clamped to the layers, the row check accepts
+ * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
+ * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
+ * and then (k, row, i) is the one tuple whose index is code. */
+SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                    uint32_t k, const simd_layout* layout)
+{
+    double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
+    vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
+    root z[DECODE_CHUNK];
+    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK);
+    if (k == 4) {
+        for (size_t b = 0; b < blocks; ++b) {
+            x[b] = layer_argument(n, rest[b]);
+            z[b] = root_start(x[b]);
+        }
+        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(n, root_finish(x[b], z[b]));
+    }
+    if (k > 2)
+        for (size_t b = 0; b < blocks; ++b) {
+            if (k == 4) {
+                rest[b] = v_sub(rest[b], layer_base(n, layer[b]));
+                bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(n));
+            } else {
+                layer[b] = v_zero();
+                bottom[b] = v_splat(n);
+            }
+            row[b] = row_estimate(bottom[b], rest[b]);
+        }
+    for (size_t b = 0; b < blocks; ++b) {
+        vec q[SP_MAX_INFLUENCES];
+        if (k == 2) {
+            q[1] = rest[b];
+            q[0] = v_sub(v_splat(2 * (n - 1)), rest[b]);
+            missed[b] = 0;
+        } else {
+            mask ok;
+            vec i = row_offset(bottom[b], row[b], rest[b], &ok);
+            unpacked_block(n, k, layer[b], row[b], i, q);
+            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
+        }
+        store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
+    }
+    for (size_t b = 0; b < blocks; ++b)
+        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+}
+
+SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                       uint32_t k)
+{
+    simd_layout layout = layout_for(k);
+    size_t v = 0;
+    while (v + BLOCK <= count) {
+        size_t blocks = (count - v) / BLOCK, valid = 0;
+        if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
+        while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
+        if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
+        decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
+        v += valid * BLOCK;
+    }
+    return v;
+}
+
+SIMD_FN size_t SIMD_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
+{
+    switch (codec->influences) {
+    case 2: return decode_blocks(codec, codes, count, weights, 2);
+    case 3: return decode_blocks(codec, codes, count, weights, 3);
+    default: return decode_blocks(codec, codes, count, weights, 4);
+    }
+}

@@ -1,0 +1,117 @@
+/*
+ * OSS batch encode and decode at every width of `skinpack bench` (K = 2..4 at 16..64 bits)
+ * against checksums recorded from the scalar code before its rewrite for speed (issue 14,
+ * commit 2cc7f20): the scalar encoder's unrolled rounding and 64-bit/128-bit closed forms, and
+ * the decoder, must give the same codes, significant counts and float bits. Every ISA the CPU
+ * has must give them too. `test_oss_golden --print` prints the table from the code under test.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../native/src/codec_internal.h" /* the *_isa batch forms */
+#include "check.h"
+#include "skinpack.h"
+
+#define VERTICES 20000
+#define SAMPLED_CODES 20000
+
+static uint64_t rng_state;
+static uint64_t next_random(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+
+static uint64_t fnv(uint64_t hash, const void* data, size_t size)
+{
+    const unsigned char* bytes = data;
+    for (size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 0x100000001b3ull;
+    return hash;
+}
+
+/* Sorted weights with 1..K non-zero slots; every 16th vertex ties (equal weights, where the
+ * rounding's tie rule decides), the rest random in 1..2^20 before normalising. */
+static void make_weights(uint32_t k, float* weights)
+{
+    for (size_t v = 0; v < VERTICES; ++v) {
+        float raw[4] = {0, 0, 0, 0}, sum = 0;
+        uint32_t used = 1 + (uint32_t)(next_random() % k);
+        for (uint32_t i = 0; i < used; ++i) {
+            raw[i] = v % 16 == 0 ? 1.0f : (float)(next_random() % (1u << 20) + 1);
+            sum += raw[i];
+        }
+        for (uint32_t i = 1; i < k; ++i)
+            for (uint32_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
+                float t = raw[j];
+                raw[j] = raw[j - 1];
+                raw[j - 1] = t;
+            }
+        for (uint32_t i = 0; i < k; ++i) weights[v * k + i] = raw[i] / sum;
+    }
+}
+
+typedef struct golden_row {
+    uint32_t k, budget;
+    uint64_t encode, decode, sampled;
+} golden_row;
+
+/* Recorded from commit 2cc7f20 (test_oss_golden --print built against it). */
+static const golden_row golden[] = {
+#include "test_oss_golden.inc"
+};
+
+static void checksums(const sp_codec* codec, const float* weights, sp_isa isa, golden_row* out)
+{
+    uint32_t k = codec->influences;
+    uint64_t* codes = malloc(SAMPLED_CODES * sizeof(uint64_t));
+    uint8_t* significant = malloc(VERTICES);
+    float* decoded = malloc(SAMPLED_CODES * k * sizeof(float));
+    CHECK(sp_encode_weights_batch_isa(codec, weights, VERTICES, codes, significant, isa) == SP_OK);
+    out->encode = fnv(fnv(14695981039346656037ull, codes, VERTICES * sizeof(uint64_t)), significant, VERTICES);
+    CHECK(sp_decode_weights_batch_isa(codec, codes, VERTICES, decoded, NULL, isa) == SP_OK);
+    out->decode = fnv(14695981039346656037ull, decoded, VERTICES * k * sizeof(float));
+    /* codes spread over the whole range, its two ends included */
+    rng_state = 0x9E3779B97F4A7C15ull ^ codec->n;
+    for (size_t i = 0; i < SAMPLED_CODES; ++i)
+        codes[i] = i == 0 ? 0 : i == 1 ? codec->max_code
+                 : codec->max_code == UINT64_MAX ? next_random() : next_random() % (codec->max_code + 1);
+    CHECK(sp_decode_weights_batch_isa(codec, codes, SAMPLED_CODES, decoded, NULL, isa) == SP_OK);
+    out->sampled = fnv(14695981039346656037ull, decoded, SAMPLED_CODES * k * sizeof(float));
+    free(codes), free(significant), free(decoded);
+}
+
+int main(int argc, char** argv)
+{
+    static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
+    static const sp_isa paths[] = {SP_ISA_SCALAR, SP_ISA_AVX2, SP_ISA_AVX512};
+    int print = argc > 1 && strcmp(argv[1], "--print") == 0;
+    float* weights = malloc(VERTICES * 4 * sizeof(float));
+    size_t row = 0;
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b, ++row) {
+            sp_codec codec;
+            CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, budgets[b], &codec) == SP_OK);
+            rng_state = 0x2545F4914F6CDD1Dull + k * 64 + budgets[b];
+            make_weights(k, weights);
+            for (size_t p = 0; p < (print ? 1 : sizeof(paths) / sizeof(paths[0])); ++p) {
+                golden_row got = {k, budgets[b], 0, 0, 0};
+                checksums(&codec, weights, paths[p], &got);
+                if (print) {
+                    printf("{%u, %u, 0x%016llxull, 0x%016llxull, 0x%016llxull},\n", k, budgets[b],
+                           (unsigned long long)got.encode, (unsigned long long)got.decode,
+                           (unsigned long long)got.sampled);
+                    continue;
+                }
+                CHECK_MSG(row < sizeof(golden) / sizeof(golden[0]) && golden[row].k == k && golden[row].budget == budgets[b],
+                          "golden row %zu", row);
+                CHECK_MSG(got.encode == golden[row].encode, "encode K=%u %u bits isa %d", k, budgets[b], (int)paths[p]);
+                CHECK_MSG(got.decode == golden[row].decode, "decode K=%u %u bits isa %d", k, budgets[b], (int)paths[p]);
+                CHECK_MSG(got.sampled == golden[row].sampled, "sampled decode K=%u %u bits isa %d", k, budgets[b],
+                          (int)paths[p]);
+            }
+        }
+    free(weights);
+    return print ? 0 : check_report("test_oss_golden");
+}
