@@ -177,7 +177,7 @@ class glTF2ExportUserExtension:
         self.is_critical = False  # Blender 5.2+ aborts the export when this is set
         self.sources = {}  # id(glTF mesh) -> MeshSource
         self.done = {}  # id(primitive attributes) -> Extension, so shared attribute dicts compress once
-        self.placeholders = []  # compact JOINTS_0/WEIGHTS_0 accessors, given fallback-buffer views at the end
+        self.placeholders = []  # (object name, compact JOINTS_0/WEIGHTS_0 accessor): fallback views come last
         last_report.clear(self.compact)
 
     def gather_mesh_hook(self, gltf_mesh, blender_mesh, blender_object, *args):
@@ -220,7 +220,7 @@ class glTF2ExportUserExtension:
     def gather_gltf_extensions_hook(self, gltf, export_settings):
         # The last hook, after the exporter laid out its buffer: JSON edits only (no binary).
         if self.enabled and self.compact:
-            add_fallback_buffer(gltf, self.placeholders)
+            add_fallback_buffer(gltf, [accessor for _, accessor in self.placeholders])
 
     def report_error(self, export_settings, message):
         last_report.errors.append(message)
@@ -248,18 +248,18 @@ class glTF2ExportUserExtension:
                                              required=self.compact)
             last_report.compressed.append((source.object_name, stats))
             if self.compact:
-                self._drop_plain_skin(primitive, joint_count, len(joints))
+                self._drop_plain_skin(source.object_name, primitive, joint_count, len(joints))
         if primitive.extensions is None:
             primitive.extensions = {}
         primitive.extensions[ext.EXTENSION_NAME] = self.done[cache_key]
 
-    def _drop_plain_skin(self, primitive, joint_count, vertex_count):
+    def _drop_plain_skin(self, object_name, primitive, joint_count, vertex_count):
         for key in [k for k in primitive.attributes if k.startswith(("JOINTS_", "WEIGHTS_"))]:
             del primitive.attributes[key]
         joints = _placeholder_accessor(ext.joint_component(joint_count), vertex_count)
         weights = _placeholder_accessor(ext.COMPONENT_FLOAT, vertex_count)
         primitive.attributes["JOINTS_0"], primitive.attributes["WEIGHTS_0"] = joints, weights
-        self.placeholders += [joints, weights]
+        self.placeholders += [(object_name, joints), (object_name, weights)]
 
 
 class ExportRefused(RuntimeError):
@@ -296,10 +296,12 @@ def post_export(export_settings):
     extension = _our_extension(export_settings)
     if extension is None or not extension.enabled or not extension.compact:
         return
-    if any(accessor.buffer_view is None for accessor in extension.placeholders):
+    unplaced = sorted({name for name, accessor in extension.placeholders if accessor.buffer_view is None})
+    if unplaced:
         # The exporter swallows hook exceptions: without this the file would have the old,
-        # zeros-reading layout (accessors without a bufferView).
-        extension.report_error(export_settings, "JOINTS_0/WEIGHTS_0 got no fallback-buffer bufferView")
+        # zeros-reading layout (JOINTS_0/WEIGHTS_0 accessors without a bufferView).
+        extension.report_error(export_settings, "%s: JOINTS_0/WEIGHTS_0 got no bufferView in the fallback buffer"
+                               % ", ".join(unplaced))
     if last_report.errors:
         raise ExportRefused("Skinpack: Compact export not written: " + "; ".join(last_report.errors))
 
