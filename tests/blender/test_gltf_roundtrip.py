@@ -213,7 +213,8 @@ def main():
                 decoded_maps.setdefault(mode, []).append(result)
         common.check(decoded_maps["FALLBACK"] == decoded_maps["COMPACT"], "modes decode differently")
 
-        # Import through the hook: the compact file (which has no JOINTS_0) gets its weights.
+        # Import through the hook: the compact file (JOINTS_0/WEIGHTS_0 in the data-less
+        # fallback buffer) gets its weights.
         for mode in ("COMPACT", "FALLBACK"):
             check_import(outputs[mode][0], decoded_maps[mode], plain)
 
