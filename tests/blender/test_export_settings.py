@@ -250,6 +250,27 @@ def check_failed_compact(args, obj):
         mesh_settings.budget = '32'
 
 
+def check_lost_fallback_buffer(args, obj):
+    """The hook that adds the compact fallback buffer fails (the 3.4 exporter swallows hook
+    exceptions): the export is refused, naming the object, instead of writing JOINTS_0/WEIGHTS_0
+    without a bufferView (read as zeros by loaders without the extension)."""
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+    original = exporter.add_fallback_buffer
+
+    def broken(gltf, placeholders):
+        raise RuntimeError("test: fallback buffer hook broken")
+
+    settings = bpy.context.scene.skinpack_export
+    settings.enabled, settings.mode = True, 'COMPACT'
+    exporter.add_fallback_buffer = broken
+    try:
+        path = os.path.join(args.out, "lost_fallback_buffer.glb")
+        expect_refusal(lambda: export(path, obj), path, "Compact export not written", obj.name, "fallback buffer")
+    finally:
+        exporter.add_fallback_buffer = original
+        settings.enabled, settings.mode = False, 'FALLBACK'
+
+
 def check_exporter_failure(args, obj):
     """The exporter itself fails between the callbacks: the preview comes back (operator at once,
     File > Export at the UI's next idle moment through a timer) and the mesh is as before."""
@@ -313,6 +334,7 @@ def main():
     check_draco(args, obj)
     check_apply_modifiers(args, obj)
     check_failed_compact(args, obj)
+    check_lost_fallback_buffer(args, obj)
     check_exporter_failure(args, obj)
     check_single_bone_message(obj)
 

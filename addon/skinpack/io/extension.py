@@ -52,3 +52,28 @@ def extension_fields(compressed, joint_count):
     if compressed.method == "any":
         fields["axisSamples"] = compressed.axis_samples()
     return fields
+
+
+# Compact mode's fallback buffer (docs/extension/loaders.md, "The container rule"): JOINTS_0 and
+# WEIGHTS_0 keep their accessors, whose views lie in a buffer with no uri and no data, marked
+# with this extension object, so a loader without the extension fails to load the file instead
+# of reading a rigid, all-zero skin. The views start at 2^24 because three.js fetches a uri-less
+# buffer as the page itself; no page is that large. The CLI writes the same layout
+# (FALLBACK_GUARD_BYTES in native/cli/gltf_edit.cpp).
+FALLBACK_GUARD_BYTES = 1 << 24
+FALLBACK_BUFFER_EXTENSIONS = {EXTENSION_NAME: {"fallback": True}}
+
+
+def fallback_layout(byte_lengths):
+    """Byte offsets in the fallback buffer for views of byte_lengths (4-aligned, from
+    FALLBACK_GUARD_BYTES), and the buffer's byteLength."""
+    offsets, end = [], FALLBACK_GUARD_BYTES
+    for length in byte_lengths:
+        offsets.append(end)
+        end = (end + int(length) + 3) & ~3
+    return offsets, end
+
+
+def accessor_byte_length(component_type, width, count):
+    """The bytes count elements of width components of component_type take, tightly packed."""
+    return int(count) * int(width) * np.dtype(NUMPY_COMPONENTS[component_type]).itemsize

@@ -105,13 +105,32 @@ def _accessor(field):
 
 
 def _placeholder_accessor(component_type, count):
-    """Compact mode: JOINTS_0/WEIGHTS_0 stay in attributes as accessors without a bufferView
-    (count, componentType, type only), as KHR_draco_mesh_compression does, so validators and
-    readers still see a skinned mesh; the data comes from the extension."""
+    """Compact mode: JOINTS_0/WEIGHTS_0 stay in attributes (count, componentType, type), so
+    validators and readers still see a skinned mesh; the data comes from the extension. Their
+    bufferViews are added in the fallback buffer once the exporter has laid out its own."""
     gltf2_io = gltf_api.gltf_io()
     return gltf2_io.Accessor(buffer_view=None, byte_offset=None, component_type=component_type, count=int(count),
                              extensions=None, extras=None, max=None, min=None, name=None, normalized=None,
                              sparse=None, type="VEC4")
+
+
+def add_fallback_buffer(gltf, placeholders):
+    """Gives the placeholder accessors bufferViews in a new data-less fallback buffer (the CLI's
+    compact layout, docs/extension/loaders.md). Runs after the exporter's buffer is final: the
+    fallback buffer is never buffer 0, which in a GLB is the BIN chunk."""
+    if not placeholders or not gltf.buffers:
+        return  # no buffer 0: the views stay unset and post_export refuses the export
+    gltf2_io = gltf_api.gltf_io()
+    lengths = [ext.accessor_byte_length(a.component_type, 4, a.count) for a in placeholders]
+    offsets, byte_length = ext.fallback_layout(lengths)
+    buffer_index = len(gltf.buffers)
+    gltf.buffers.append(gltf2_io.Buffer(byte_length=byte_length, extensions=dict(ext.FALLBACK_BUFFER_EXTENSIONS),
+                                        extras=None, name=None, uri=None))
+    for accessor, offset, length in zip(placeholders, offsets, lengths):
+        accessor.buffer_view = len(gltf.buffer_views)
+        gltf.buffer_views.append(gltf2_io.BufferView(buffer=buffer_index, byte_length=length, byte_offset=offset,
+                                                     byte_stride=None, extensions=None, extras=None, name=None,
+                                                     target=None))
 
 
 def extension_json(compressed, joint_count):
@@ -158,6 +177,7 @@ class glTF2ExportUserExtension:
         self.is_critical = False  # Blender 5.2+ aborts the export when this is set
         self.sources = {}  # id(glTF mesh) -> MeshSource
         self.done = {}  # id(primitive attributes) -> Extension, so shared attribute dicts compress once
+        self.placeholders = []  # (object name, compact JOINTS_0/WEIGHTS_0 accessor): fallback views come last
         last_report.clear(self.compact)
 
     def gather_mesh_hook(self, gltf_mesh, blender_mesh, blender_object, *args):
@@ -197,6 +217,11 @@ class glTF2ExportUserExtension:
             _log(export_settings, "warning", message)
         _log(export_settings, "info", last_report.summary())
 
+    def gather_gltf_extensions_hook(self, gltf, export_settings):
+        # The last hook, after the exporter laid out its buffer: JSON edits only (no binary).
+        if self.enabled and self.compact:
+            add_fallback_buffer(gltf, [accessor for _, accessor in self.placeholders])
+
     def report_error(self, export_settings, message):
         last_report.errors.append(message)
         self.is_critical = self.is_critical or self.compact
@@ -223,17 +248,18 @@ class glTF2ExportUserExtension:
                                              required=self.compact)
             last_report.compressed.append((source.object_name, stats))
             if self.compact:
-                self._drop_plain_skin(primitive, joint_count, len(joints))
+                self._drop_plain_skin(source.object_name, primitive, joint_count, len(joints))
         if primitive.extensions is None:
             primitive.extensions = {}
         primitive.extensions[ext.EXTENSION_NAME] = self.done[cache_key]
 
-    @staticmethod
-    def _drop_plain_skin(primitive, joint_count, vertex_count):
+    def _drop_plain_skin(self, object_name, primitive, joint_count, vertex_count):
         for key in [k for k in primitive.attributes if k.startswith(("JOINTS_", "WEIGHTS_"))]:
             del primitive.attributes[key]
-        primitive.attributes["JOINTS_0"] = _placeholder_accessor(ext.joint_component(joint_count), vertex_count)
-        primitive.attributes["WEIGHTS_0"] = _placeholder_accessor(ext.COMPONENT_FLOAT, vertex_count)
+        joints = _placeholder_accessor(ext.joint_component(joint_count), vertex_count)
+        weights = _placeholder_accessor(ext.COMPONENT_FLOAT, vertex_count)
+        primitive.attributes["JOINTS_0"], primitive.attributes["WEIGHTS_0"] = joints, weights
+        self.placeholders += [(object_name, joints), (object_name, weights)]
 
 
 class ExportRefused(RuntimeError):
@@ -268,7 +294,15 @@ def post_export(export_settings):
     that left a skinned primitive uncompressed fails instead of writing a file without its skin."""
     restore_previews()
     extension = _our_extension(export_settings)
-    if extension is not None and extension.enabled and extension.compact and last_report.errors:
+    if extension is None or not extension.enabled or not extension.compact:
+        return
+    unplaced = sorted({name for name, accessor in extension.placeholders if accessor.buffer_view is None})
+    if unplaced:
+        # The exporter swallows hook exceptions: without this the file would have the old,
+        # zeros-reading layout (JOINTS_0/WEIGHTS_0 accessors without a bufferView).
+        extension.report_error(export_settings, "%s: JOINTS_0/WEIGHTS_0 got no bufferView in the fallback buffer"
+                               % ", ".join(unplaced))
+    if last_report.errors:
         raise ExportRefused("Skinpack: Compact export not written: " + "; ".join(last_report.errors))
 
 
