@@ -12,7 +12,7 @@ import { allCases, CLI, fallbackBufferLayout, WORK } from './cases.mjs';
 import { readGltf, readAccessor } from './gltf_file.mjs';
 import { core, functions, MeshoptEncoder } from './web_modules.mjs';
 import { SkinpackPackedSkin, WORDS_ATTRIBUTE } from '../../web/gltf-transform/SkinpackPackedSkin.js';
-import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
+import { compactLayout, SKINPACK_EXTENSION } from '../../web/src/decode.js';
 
 const ROOT = fileURLToPath(new URL('../../', import.meta.url));
 const GLTF_TRANSFORM_CLI = join(ROOT, 'tools/node_modules/.bin/gltf-transform');
@@ -60,8 +60,10 @@ function packedState(path) {
   assert.equal(primitive.attributes[WORDS_ATTRIBUTE], undefined, 'the in-memory words attribute leaked into the file');
   const words = json.accessors[primitive.extensions[SKINPACK_EXTENSION].vertices];
   assert.equal(json.bufferViews[words.bufferView].target, undefined, 'the words bufferView has a target');
-  const joints = json.accessors[primitive.attributes.JOINTS_0];
-  return { compact: joints.bufferView === undefined, required: (json.extensionsRequired || []).includes(SKINPACK_EXTENSION) };
+  // Compact files are written in the fallback-buffer layout only (a loader without the extension must refuse them).
+  const layout = compactLayout(json, primitive);
+  assert.ok(layout === null || layout === 'fallback-buffer', `${path}: compact placeholders in the ${layout} layout`);
+  return { compact: layout === 'fallback-buffer', required: (json.extensionsRequired || []).includes(SKINPACK_EXTENSION) };
 }
 
 function firstWords(path) {

@@ -11,8 +11,9 @@
 // result that no longer decodes (or whose word count left the vertex count) makes the write
 // throw, naming the mesh and primitive, instead of writing a silently wrong skin.
 // Meshlets index vertices and triangles; operations invalidate them, so they are dropped on read.
-// Compact files are written with data-less JOINTS_0/WEIGHTS_0 accessors (no bufferView), also
-// when read in the fallback-buffer layout (a GLB written by glTF-Transform holds one buffer).
+// Compact files are written in the fallback-buffer layout the spec gives (JOINTS_0/WEIGHTS_0
+// accessors whose bufferViews lie in a buffer without data, marked as the extension's fallback),
+// so a loader without the extension refuses them; the reader gives such views zero bytes.
 
 import { Extension, ExtensionProperty, PropertyType } from '@gltf-transform/core';
 import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from '../src/decode.js';
@@ -20,6 +21,9 @@ import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPA
 export const WORDS_ATTRIBUTE = '_SKINPACK_WORDS';
 const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'weightBits', 'tupleBits', 'maxError'];
 const UNSIGNED_BYTE = 5121, UNSIGNED_SHORT = 5123, FLOAT = 5126;
+// The fallback buffer's views start here: three.js fetches a buffer without uri as the page
+// itself, and an offset past any page makes that fetch fail too (docs/extension/README.md).
+const FALLBACK_VIEW_OFFSET = 1 << 24;
 
 /** The extension on one primitive: the tuple table accessor and the codec parameters. */
 export class PackedSkin extends ExtensionProperty {
@@ -49,9 +53,20 @@ export class SkinpackPackedSkin extends Extension {
   static EXTENSION_NAME = SKINPACK_EXTENSION;
   extensionName = SKINPACK_EXTENSION;
   prewriteTypes = [PropertyType.ACCESSOR];
+  prereadTypes = [PropertyType.BUFFER];
 
   createPackedSkin() {
     return new PackedSkin(this.document.getGraph());
+  }
+
+  // Views of a fallback buffer have no bytes to read: zeros stand in for the placeholders, which
+  // read() then removes (the packed words are the primitive's skin).
+  preread(context) {
+    const json = context.jsonDoc.json;
+    (json.bufferViews || []).forEach((viewDef, index) => {
+      if (isFallbackBuffer((json.buffers || [])[viewDef.buffer])) context.bufferViews[index] = new Uint8Array(viewDef.byteLength);
+    });
+    return this;
   }
 
   read(context) {
@@ -104,7 +119,7 @@ export class SkinpackPackedSkin extends Extension {
 
   write(context) {
     const json = context.jsonDoc.json;
-    let compact = false;
+    const placeholders = { views: [], byteLength: FALLBACK_VIEW_OFFSET };
     this.document.getRoot().listMeshes().forEach((mesh) => {
       const meshIndex = context.meshIndexMap.get(mesh);
       mesh.listPrimitives().forEach((primitive, p) => {
@@ -119,13 +134,11 @@ export class SkinpackPackedSkin extends Extension {
         delete primitiveDef.attributes[WORDS_ATTRIBUTE];
         primitiveDef.extensions = primitiveDef.extensions || {};
         primitiveDef.extensions[SKINPACK_EXTENSION] = def;
-        if (packed.getCompact()) {
-          compact = true;
-          addPlaceholders(json, primitiveDef, words.getCount(), def.jointCount);
-        }
+        if (packed.getCompact()) addPlaceholders(json, primitiveDef, words.getCount(), def.jointCount, placeholders);
       });
     });
-    if (compact && !(json.extensionsRequired || []).includes(SKINPACK_EXTENSION))
+    if (placeholders.views.length) addFallbackBuffer(json, placeholders);
+    if (placeholders.views.length && !(json.extensionsRequired || []).includes(SKINPACK_EXTENSION))
       (json.extensionsRequired = json.extensionsRequired || []).push(SKINPACK_EXTENSION);
     return this;
   }
@@ -146,9 +159,25 @@ function checkDecodes(def, primitive, words, table, where) {
   }
 }
 
-// Compact mode: JOINTS_0/WEIGHTS_0 accessors without bufferView (KHR_draco_mesh_compression style).
-function addPlaceholders(json, primitiveDef, count, jointCount) {
+// Compact mode: JOINTS_0/WEIGHTS_0 accessors on views of the fallback buffer (no data).
+function addPlaceholders(json, primitiveDef, count, jointCount, placeholders) {
   json.accessors = json.accessors || [];
-  primitiveDef.attributes.JOINTS_0 = json.accessors.push({ componentType: jointCount <= 256 ? UNSIGNED_BYTE : UNSIGNED_SHORT, count, type: 'VEC4' }) - 1;
-  primitiveDef.attributes.WEIGHTS_0 = json.accessors.push({ componentType: FLOAT, count, type: 'VEC4' }) - 1;
+  json.bufferViews = json.bufferViews || [];
+  const add = (componentType, bytesPerComponent) => {
+    const byteLength = count * 4 * bytesPerComponent; // VEC4, a multiple of 4
+    const view = json.bufferViews.push({ buffer: -1, byteOffset: placeholders.byteLength, byteLength }) - 1;
+    placeholders.views.push(view);
+    placeholders.byteLength += byteLength;
+    return json.accessors.push({ bufferView: view, componentType, count, type: 'VEC4' }) - 1;
+  };
+  const joints16 = jointCount > 256;
+  primitiveDef.attributes.JOINTS_0 = add(joints16 ? UNSIGNED_SHORT : UNSIGNED_BYTE, joints16 ? 2 : 1);
+  primitiveDef.attributes.WEIGHTS_0 = add(FLOAT, 4);
+}
+
+// The buffer the placeholders' views lie in: byteLength only, marked as the fallback, never buffer 0.
+function addFallbackBuffer(json, placeholders) {
+  json.buffers = json.buffers || [];
+  const buffer = json.buffers.push({ byteLength: placeholders.byteLength, extensions: { [SKINPACK_EXTENSION]: { fallback: true } } }) - 1;
+  for (const view of placeholders.views) json.bufferViews[view].buffer = buffer;
 }
