@@ -278,15 +278,11 @@ static size_t cut_accessor_bytes(gltf_doc* doc, size_t accessor_index, size_t vi
 
 // ---- new data ----
 
-// The fallback buffer's views start this far in. A loader without the extension that fetches
-// the missing uri as "" gets the page it runs in (three.js's GLTFLoader does); no page is this
-// large, so its range check fails instead of it reading the page's bytes as weights.
-static const size_t FALLBACK_GUARD_BYTES = size_t(1) << 24;
 
 // Reserves size bytes, 4-aligned, in the new data (or the fallback buffer); returns the offset.
 static size_t reserve(gltf_doc* doc, const void* data, size_t size) {
     if (!data) {
-        if (doc->fallback_bytes == 0) doc->fallback_bytes = FALLBACK_GUARD_BYTES;
+        if (doc->fallback_bytes == 0) doc->fallback_bytes = SP_FALLBACK_VIEW_OFFSET; /* see skinpack.h */
         size_t offset = doc->fallback_bytes;
         doc->fallback_bytes = (offset + size + 3) & ~size_t(3);
         return offset;

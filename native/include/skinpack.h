@@ -41,6 +41,10 @@ extern "C" {
 #define SP_MAX_JOINTS 65535         /* joint indices are stored as u16 */
 #define SP_MAX_WEIGHT_BITS 64       /* largest weight code */
 #define SP_MAX_VERTEX_BITS 64       /* tuple index + weight code, one or two 32-bit words */
+/* Compact mode: the views of the data-less fallback buffer start this far in (2^24). A loader
+ * without the extension that fetches the missing uri as "" gets the page it runs in (three.js
+ * does); no page is this large, so its range check fails instead of reading the page as weights. */
+#define SP_FALLBACK_VIEW_OFFSET 16777216
 #define SP_ERROR_HISTOGRAM_BINS 16
 
 typedef enum sp_result {

@@ -6,6 +6,8 @@ the same fields back. Field names and the LUT's component width are defined once
 
 import numpy as np
 
+from . import _abi  # generated from skinpack.h (addon/generate_abi.py)
+
 EXTENSION_NAME = "SKINPACK_packed_skin"
 
 COMPONENT_UNSIGNED_BYTE = 5121
@@ -58,9 +60,8 @@ def extension_fields(compressed, joint_count):
 # WEIGHTS_0 keep their accessors, whose views lie in a buffer with no uri and no data, marked
 # with this extension object, so a loader without the extension fails to load the file instead
 # of reading a rigid, all-zero skin. The views start at 2^24 because three.js fetches a uri-less
-# buffer as the page itself; no page is that large. The CLI writes the same layout
-# (FALLBACK_GUARD_BYTES in native/cli/gltf_edit.cpp).
-FALLBACK_GUARD_BYTES = 1 << 24
+# buffer as the page itself; no page is that large. The offset is the library's, as the CLI's.
+FALLBACK_GUARD_BYTES = _abi.CONSTANTS["SP_FALLBACK_VIEW_OFFSET"]
 FALLBACK_BUFFER_EXTENSIONS = {EXTENSION_NAME: {"fallback": True}}
 
 
