@@ -19,56 +19,50 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
                              uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
                              size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
     memset(out, 0, sizeof(*out));
-    if (packed->influences < 1 || packed->influences > SP_MAX_INFLUENCES)
-        return fail(err, err_size, "influences %u is out of range 1..%d", packed->influences, SP_MAX_INFLUENCES);
-    if (packed->joint_count < 1 || packed->joint_count > SP_MAX_JOINTS)
-        return fail(err, err_size, "jointCount %u is out of range 1..%d", packed->joint_count, SP_MAX_JOINTS);
-    if (skin_joint_count && packed->joint_count > skin_joint_count)
-        return fail(err, err_size, "jointCount %u is larger than the skin's %zu joints", packed->joint_count,
-                     skin_joint_count);
-    if (packed->weight_bits > SP_MAX_WEIGHT_BITS || packed->tuple_bits > 32)
-        return fail(err, err_size, "bit widths out of range (weightBits %u, tupleBits %u)", packed->weight_bits,
-                     packed->tuple_bits);
-    if (lut_size == 0) return fail(err, err_size, "the tuple table is empty");
-    if (packed->tuple_bits != sp_index_bits(lut_size))
-        return fail(err, err_size, "tupleBits %u does not match the tuple table's %zu entries (needs %u)",
-                     packed->tuple_bits, lut_size, sp_index_bits(lut_size));
-
-    sp_codec codec;
-    const uint64_t* axes = packed->method == SP_METHOD_ANY ? packed->axis_samples : NULL;
-    sp_result r = sp_codec_from_params((sp_method)packed->method, packed->influences, packed->n, axes, &codec);
-    if (r != SP_OK)
-        return fail(err, err_size, "invalid codec parameters (method %s, influences %u, n %llu): %s",
-                     sp_method_name((sp_method)packed->method), packed->influences, (unsigned long long)packed->n,
-                     sp_result_string(r));
-    if (codec.bits != packed->weight_bits)
-        return fail(err, err_size, "weightBits %u does not match the codec, which needs %u", packed->weight_bits,
-                     codec.bits);
-    uint32_t wpv = sp_words_per_vertex(packed->tuple_bits, packed->weight_bits);
-    if (wpv == 0 || wpv != words_per_vertex)
-        return fail(err, err_size, "%u bits a vertex need %u words, the vertices accessor has %u",
-                     packed->tuple_bits + packed->weight_bits, wpv, words_per_vertex);
+    /* Every format rule is the library's (sp_validate_packed); this only passes what the file says. */
+    sp_packed_primitive primitive;
+    memset(&primitive, 0, sizeof(primitive));
+    sp_packed_params* p = &primitive.params;
+    p->method = packed->method;
+    p->influences = packed->influences;
+    p->joint_count = packed->joint_count;
+    p->weight_bits = packed->weight_bits;
+    p->tuple_bits = packed->tuple_bits;
+    p->n = packed->n;
+    p->axis_sample_count = packed->axis_sample_count;
+    for (uint32_t i = 0; i < packed->axis_sample_count && i < SP_MAX_INFLUENCES - 1; ++i)
+        p->axis_samples[i] = packed->axis_samples[i];
+    p->has_max_error = isfinite(packed->max_error);
+    p->max_error = p->has_max_error ? packed->max_error : 0;
+    primitive.words = words;
+    primitive.vertex_count = vertex_count;
+    primitive.words_per_vertex = words_per_vertex;
+    primitive.primitive_vertex_count = vertex_count; /* checked against POSITION by the caller's reader */
+    primitive.lut = lut;
+    primitive.lut_size = lut_size;
+    primitive.lut_components = packed->influences;
+    primitive.lut_component_bytes = packed->joint_count <= 256 ? 1 : 2; /* gltf_packed_sizes checked the type */
+    primitive.skin_joint_count = skin_joint_count;
 
     uint32_t k = packed->influences;
-    out->joints = (uint16_t*)malloc(vertex_count * k * sizeof(uint16_t));
-    out->weights = (float*)malloc(vertex_count * k * sizeof(float));
+    out->joints = (uint16_t*)malloc(vertex_count * k * sizeof(uint16_t) + 1);
+    out->weights = (float*)malloc(vertex_count * k * sizeof(float) + 1);
     if (!out->joints || !out->weights) {
         cli_decoded_skin_free(out);
         return fail(err, err_size, "out of memory");
     }
-    size_t bad_vertex = 0;
-    r = sp_decompress_skin(&codec, words, vertex_count, packed->tuple_bits, lut, lut_size, packed->joint_count,
-                           out->joints, out->weights, &bad_vertex);
-    if (r != SP_OK) {
+    sp_validation report;
+    if (sp_validate_packed(&primitive, out->joints, out->weights, &report) != SP_OK) {
         cli_decoded_skin_free(out);
-        return fail(err, err_size, "vertex %zu: %s", bad_vertex, sp_result_string(r));
+        sp_format_validation(&report, err, err_size);
+        return -1;
     }
-    out->codec = codec;
+    out->codec = report.codec;
     out->vertex_count = vertex_count;
     out->lut_size = lut_size;
     out->influences = k;
-    out->words_per_vertex = wpv;
-    out->joint_bytes = packed->joint_count <= 256 ? 1 : 2;
+    out->words_per_vertex = words_per_vertex;
+    out->joint_bytes = primitive.lut_component_bytes;
     return 0;
 }
 
@@ -250,4 +244,12 @@ void cli_json_number(FILE* out, double v) {
         fprintf(out, "%.9g", v);
     else
         fputs("null", out);
+}
+
+void* cli_grow(void* array, size_t* capacity, size_t count, size_t item_size) {
+    if (count < *capacity) return array;
+    size_t grown = *capacity ? *capacity * 2 : 16;
+    void* moved = realloc(array, grown * item_size);
+    if (moved) *capacity = grown;
+    return moved;
 }

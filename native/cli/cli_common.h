@@ -65,6 +65,10 @@ double cli_lut_bits_per_vertex(size_t lut_size, uint32_t influences, uint32_t jo
 double cli_vertex_difference(const uint16_t* joints_a, const float* weights_a, size_t k_a, const uint16_t* joints_b,
                              const float* weights_b, size_t k_b);
 
+/* Makes room for one more item in a malloc'ed array of count items (doubling *capacity).
+ * Returns the array, moved or not, or NULL when out of memory (the old array is still valid). */
+void* cli_grow(void* array, size_t* capacity, size_t count, size_t item_size);
+
 /* Size of a file in bytes, 0 if it cannot be read. */
 size_t cli_file_size(const char* path);
 

@@ -18,6 +18,7 @@ typedef struct compress_args {
     int compact;
     int json;
     int meshlets; /* --meshlets: also write skin-aware meshlets */
+    int weight_bits_given; /* --weight-bits (0 in options.weight_bits means "not given") */
 } compress_args;
 
 /* One primitive's outcome. Primitives with the same JOINTS_n/WEIGHTS_n accessors share the
@@ -30,9 +31,24 @@ typedef struct compressed_primitive {
     sp_compressed_skin skin;
     double input_bits_per_vertex;  /* JOINTS_n + WEIGHTS_n as stored in the input */
     double output_bits_per_vertex; /* vertex words + tuple table as stored in the output */
-    int placeholder_joints, placeholder_weights; /* compact mode: data-less JOINTS_0/WEIGHTS_0 */
     sp_meshlet_stats meshlet_stats; /* --meshlets */
 } compressed_primitive;
+
+/*
+ * Compact mode: the primitive keeps JOINTS_0/WEIGHTS_0, but their data moves to the fallback
+ * buffer (no bytes), as EXT_meshopt_compression does it: a loader without the extension fails
+ * to load the buffer instead of reading zeros, one with it fills them from the packed data.
+ * JOINTS_1/WEIGHTS_1 go (the packed skin has at most 4 influences). The freed bytes are cut.
+ */
+static void make_compact(gltf_doc* doc, const compressed_primitive* p) {
+    const gltf_skin_attributes* at = &p->attributes;
+    gltf_set_skin_attributes(doc, p->mesh, p->primitive, at->joints[0], at->weights[0]);
+    if (p->shared_with >= 0) return; /* the first primitive with these accessors moved them */
+    for (size_t s = 0; s < at->sets; ++s) {
+        gltf_make_fallback(doc, at->joints[s]);
+        gltf_make_fallback(doc, at->weights[s]);
+    }
+}
 
 static void compress_usage(FILE* out) {
     fprintf(out,
@@ -58,6 +74,75 @@ static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
     return 0;
 }
 
+/* The weight-code widths the library accepts for a method and K (lo > hi: none). */
+static void weight_bits_range(sp_method method, uint32_t k, uint32_t* lo, uint32_t* hi) {
+    *lo = SP_MAX_WEIGHT_BITS + 1;
+    *hi = 0;
+    for (uint32_t b = 0; b <= SP_MAX_WEIGHT_BITS; ++b) {
+        sp_codec codec;
+        if (sp_codec_from_bits(method, k, b, &codec) != SP_OK) continue;
+        if (b < *lo) *lo = b;
+        *hi = b;
+    }
+}
+
+/* --weight-bits / --vertex-bits against what the method can do with --max-influences
+ * influences (a primitive with fewer influences is checked again when it is compressed). */
+static int check_budget(const compress_args* args) {
+    const sp_compress_options* o = &args->options;
+    uint32_t lo, hi;
+    weight_bits_range(o->method, o->max_influences, &lo, &hi);
+    const char* name = sp_method_name(o->method);
+    if (lo > hi) {
+        fprintf(stderr, "skinpack compress: --method %s is not defined for %u influences (--max-influences)\n", name,
+                o->max_influences);
+        return -1;
+    }
+    if (args->weight_bits_given && (o->weight_bits == 0 || o->weight_bits < lo || o->weight_bits > hi)) {
+        fprintf(stderr, "skinpack compress: --weight-bits %u: method %s with %u influences takes %u..%u bits\n",
+                o->weight_bits, name, o->max_influences, lo ? lo : 1, hi);
+        return -1;
+    }
+    if (o->vertex_bits && o->vertex_bits < lo) {
+        fprintf(stderr, "skinpack compress: --vertex-bits %u: method %s with %u influences needs at least %u bits for "
+                "the weights, plus the tuple index\n", o->vertex_bits, name, o->max_influences, lo);
+        return -1;
+    }
+    return 0;
+}
+
+static int is_budget_option(const char* a) {
+    return strcmp(a, "--vertex-bits") == 0 || strcmp(a, "--weight-bits") == 0 || strcmp(a, "--max-error") == 0;
+}
+
+/* --vertex-bits, --weight-bits or --max-error: the one budget (0 in options means "not this"). */
+static int parse_budget(const char* a, const char* value, compress_args* args) {
+    sp_compress_options* o = &args->options;
+    if (strcmp(a, "--vertex-bits") == 0) {
+        o->weight_bits = 0;
+        if (parse_uint(value, SP_MAX_VERTEX_BITS, &o->vertex_bits) || !o->vertex_bits) {
+            fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
+            return -1;
+        }
+    } else if (strcmp(a, "--weight-bits") == 0) {
+        o->vertex_bits = 0;
+        args->weight_bits_given = 1;
+        if (parse_uint(value, SP_MAX_WEIGHT_BITS, &o->weight_bits)) {
+            fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
+            return -1;
+        }
+    } else {
+        char* end = NULL;
+        args->max_error = strtod(value, &end);
+        if (*end || !(args->max_error > 0 && args->max_error < 1)) {
+            fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
+            return -1;
+        }
+        o->vertex_bits = 0;
+    }
+    return 0;
+}
+
 static int parse_args(int argc, char** argv, compress_args* args) {
     memset(args, 0, sizeof(*args));
     sp_compress_options_default(&args->options);
@@ -71,34 +156,14 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         } else if (strcmp(a, "--method") == 0 && value) {
             args->options.method = sp_method_from_name(value);
             if (args->options.method == SP_METHOD_COUNT) {
-                fprintf(stderr, "skinpack compress: unknown method '%s'\n", value);
+                fprintf(stderr, "skinpack compress: --method: unknown method '%s' (", value);
+                for (int m = 0; m < SP_METHOD_COUNT; ++m) fprintf(stderr, "%s%s", m ? ", " : "", sp_method_name((sp_method)m));
+                fprintf(stderr, ")\n");
                 return -1;
             }
             ++i;
-        } else if (strcmp(a, "--vertex-bits") == 0 && value) {
-            args->options.weight_bits = 0;
-            if (parse_uint(value, SP_MAX_VERTEX_BITS, &args->options.vertex_bits) || !args->options.vertex_bits) {
-                fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
-                return -1;
-            }
-            ++budgets;
-            ++i;
-        } else if (strcmp(a, "--weight-bits") == 0 && value) {
-            args->options.vertex_bits = 0;
-            if (parse_uint(value, SP_MAX_WEIGHT_BITS, &args->options.weight_bits)) {
-                fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
-                return -1;
-            }
-            ++budgets;
-            ++i;
-        } else if (strcmp(a, "--max-error") == 0 && value) {
-            char* end = NULL;
-            args->max_error = strtod(value, &end);
-            if (*end || !(args->max_error > 0 && args->max_error < 1)) {
-                fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
-                return -1;
-            }
-            args->options.vertex_bits = 0;
+        } else if (is_budget_option(a) && value) {
+            if (parse_budget(a, value, args)) return -1;
             ++budgets;
             ++i;
         } else if (strcmp(a, "--max-influences") == 0 && value) {
@@ -132,6 +197,7 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         fprintf(stderr, "skinpack compress: give at most one of --vertex-bits, --weight-bits, --max-error\n");
         return -1;
     }
+    if (check_budget(args)) return -1;
     if (!args->input || !args->output) {
         compress_usage(stderr);
         return -1;
@@ -282,6 +348,24 @@ done:
     return rc;
 }
 
+/* Why sp_compress_skin refused a primitive, in terms of the file and the options. */
+static void describe_failure(sp_result r, const compressed_primitive* p, const sp_compress_options* options,
+                             size_t joint_count, char* err, size_t err_size) {
+    uint32_t lo, hi, k = p->skin.influences ? p->skin.influences : options->max_influences;
+    weight_bits_range(options->method, k, &lo, &hi);
+    if (r == SP_ERR_JOINT_OUT_OF_RANGE)
+        snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
+                 p->skin.prepare.error_joint, joint_count);
+    else if (r == SP_ERR_BITS_OUT_OF_RANGE || r == SP_ERR_INVALID_ARGUMENT)
+        snprintf(err, err_size, "the bit budget (%s %u) fits no %s configuration for %u influences (the weights "
+                 "take %u..%u bits; with the tuple index at most %d bits in all)",
+                 options->weight_bits ? "--weight-bits" : "--vertex-bits",
+                 options->weight_bits ? options->weight_bits : options->vertex_bits, sp_method_name(options->method),
+                 k, lo, hi, SP_MAX_VERTEX_BITS);
+    else
+        snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
+}
+
 static int compress_primitive(gltf_doc* doc, const compress_args* args, compressed_primitive* p, char* err,
                               size_t err_size) {
     const gltf_skin_attributes* at = &p->attributes;
@@ -313,11 +397,7 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     sp_result r = sp_compress_skin(joints, weights, vc, stride, joint_count, &options, words, lut, NULL, NULL,
                                    &p->skin, scratch, scratch_size);
     if (r != SP_OK) {
-        if (r == SP_ERR_JOINT_OUT_OF_RANGE)
-            snprintf(err, err_size, "vertex %zu: joint %u is past the skin's %zu joints", p->skin.prepare.error_vertex,
-                     p->skin.prepare.error_joint, joint_count);
-        else
-            snprintf(err, err_size, "vertex %zu: %s", p->skin.prepare.error_vertex, sp_result_string(r));
+        describe_failure(r, p, &options, joint_count, err, err_size);
         goto done;
     }
 
@@ -329,6 +409,7 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
     p->packed.method = s->codec.method;
     p->packed.n = s->codec.n;
     for (uint32_t i = 0; i + 1 < k && i < 3; ++i) p->packed.axis_samples[i] = s->codec.axis_samples[i];
+    p->packed.axis_sample_count = s->codec.method == SP_METHOD_ANY && k > 1 ? k - 1 : 0; /* as it is written */
     p->packed.weight_bits = s->weight_bits;
     p->packed.tuple_bits = s->tuple_bits;
     p->packed.max_error = s->codec.max_error;
@@ -450,6 +531,77 @@ static void print_table(const compress_args* args, const compressed_primitive* p
            args->compact ? "" : " (JOINTS_0/WEIGHTS_0 are kept as well)", input_bytes, output_bytes);
 }
 
+/* Every skinned primitive, checked; primitives with the same accessors (and, with meshlets, the
+ * same geometry) point at the first with shared_with. Returns the count, or -1 after a message. */
+static long find_skinned(const gltf_doc* doc, const compress_args* args, compressed_primitive** out) {
+    char err[CLI_ERR_SIZE];
+    size_t capacity = 0, count = 0;
+    compressed_primitive* prims = NULL;
+    for (size_t m = 0; m < gltf_mesh_count(doc); ++m) {
+        for (size_t pi = 0; pi < gltf_primitive_count(doc, m); ++pi) {
+            gltf_packed_skin existing;
+            gltf_skin_attributes attributes;
+            int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
+            if (has > 0)
+                snprintf(err, sizeof(err), "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first");
+            int skinned = has == 0 ? gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err)) : -1;
+            if (skinned > 0 && attributes.placeholder) {
+                snprintf(err, sizeof(err), "JOINTS_0/WEIGHTS_0 have no data (no bufferView, or a buffer without data) "
+                         "and there is no " GLTF_EXTENSION_NAME " to supply it");
+                skinned = -1;
+            }
+            if (skinned < 0) {
+                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, m, pi, err);
+                free(prims);
+                return -1;
+            }
+            if (!skinned) continue;
+            compressed_primitive* grown = cli_grow(prims, &capacity, count, sizeof(*prims));
+            if (!grown) {
+                fprintf(stderr, "skinpack compress: out of memory\n");
+                free(prims);
+                return -1;
+            }
+            prims = grown;
+            compressed_primitive* p = &prims[count];
+            memset(p, 0, sizeof(*p));
+            p->mesh = m;
+            p->primitive = pi;
+            p->attributes = attributes;
+            p->shared_with = -1;
+            for (size_t j = 0; j < count && p->shared_with < 0; ++j)
+                if (prims[j].shared_with < 0 && same_attributes(&prims[j].attributes, &attributes) &&
+                    (!args->meshlets || gltf_same_geometry(doc, prims[j].mesh, prims[j].primitive, m, pi)))
+                    p->shared_with = (long)j;
+            ++count;
+        }
+    }
+    *out = prims;
+    return (long)count;
+}
+
+/* Compresses each primitive once (the shared ones take the first's result). */
+static int compress_all(gltf_doc* doc, const compress_args* args, compressed_primitive* prims, size_t count) {
+    char err[CLI_ERR_SIZE];
+    for (size_t i = 0; i < count; ++i) {
+        compressed_primitive* p = &prims[i];
+        if (p->shared_with >= 0) {
+            const compressed_primitive* first = &prims[p->shared_with];
+            p->skin = first->skin;
+            p->packed = first->packed;
+            p->input_bits_per_vertex = first->input_bits_per_vertex;
+            p->output_bits_per_vertex = first->output_bits_per_vertex;
+            p->meshlet_stats = first->meshlet_stats;
+        } else if (compress_primitive(doc, args, p, err, sizeof(err))) {
+            fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, p->mesh, p->primitive,
+                    err);
+            return -1;
+        }
+        gltf_set_packed(doc, p->mesh, p->primitive, &p->packed);
+    }
+    return 0;
+}
+
 int skinpack_cmd_compress(int argc, char** argv) {
     compress_args args;
     if (parse_args(argc, argv, &args)) return 2;
@@ -459,88 +611,28 @@ int skinpack_cmd_compress(int argc, char** argv) {
         fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
         return 1;
     }
-    size_t capacity = 0, count = 0;
     compressed_primitive* prims = NULL;
     int rc = 1;
-    for (size_t m = 0; m < gltf_mesh_count(doc); ++m) {
-        for (size_t pi = 0; pi < gltf_primitive_count(doc, m); ++pi) {
-            gltf_packed_skin existing;
-            int has = gltf_get_packed(doc, m, pi, &existing, err, sizeof(err));
-            if (has != 0) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi,
-                        has > 0 ? "already carries " GLTF_EXTENSION_NAME "; run skinpack decompress first" : err);
-                goto done;
-            }
-            gltf_skin_attributes attributes;
-            int skinned = gltf_primitive_skin(doc, m, pi, &attributes, err, sizeof(err));
-            if (skinned < 0) {
-                fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
-                goto done;
-            }
-            if (!skinned) continue;
-            if (attributes.placeholder) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: JOINTS_0/WEIGHTS_0 have no data and "
-                        "there is no " GLTF_EXTENSION_NAME "\n", args.input, m, pi);
-                goto done;
-            }
-            if (count == capacity) {
-                capacity = capacity ? capacity * 2 : 16;
-                compressed_primitive* grown = realloc(prims, capacity * sizeof(*prims));
-                if (!grown) {
-                    fprintf(stderr, "skinpack compress: out of memory\n");
-                    goto done;
-                }
-                prims = grown;
-            }
-            compressed_primitive* p = &prims[count];
-            memset(p, 0, sizeof(*p));
-            p->mesh = m;
-            p->primitive = pi;
-            p->attributes = attributes;
-            p->shared_with = -1;
-            for (size_t j = 0; j < count; ++j)
-                if (prims[j].shared_with < 0 && same_attributes(&prims[j].attributes, &attributes) &&
-                    (!args.meshlets || gltf_same_geometry(doc, prims[j].mesh, prims[j].primitive, m, pi))) {
-                    p->shared_with = (long)j;
-                    p->skin = prims[j].skin;
-                    p->packed = prims[j].packed;
-                    p->input_bits_per_vertex = prims[j].input_bits_per_vertex;
-                    p->output_bits_per_vertex = prims[j].output_bits_per_vertex;
-                    p->meshlet_stats = prims[j].meshlet_stats;
-                    break;
-                }
-            if (p->shared_with < 0 && compress_primitive(doc, &args, p, err, sizeof(err))) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args.input, m, pi, err);
-                goto done;
-            }
-            ++count;
+    long found = find_skinned(doc, &args, &prims);
+    if (found < 0) goto done;
+    size_t count = (size_t)found;
+    if (count == 0) {
+        size_t copied = 0;
+        if (gltf_write_unchanged(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &copied,
+                                 err, sizeof(err))) {
+            fprintf(stderr, "skinpack compress: %s\n", err);
+            goto done;
         }
-    }
-    /* Edit the primitives only after every one compressed: accessors are shared. Compact mode
-     * keeps JOINTS_0/WEIGHTS_0 on accessors without data, as KHR_draco_mesh_compression does:
-     * the skin still has a skinned mesh (the Khronos validator insists) and a decoder knows
-     * which attributes the extension supplies. */
-    for (size_t i = 0; i < count; ++i) {
-        compressed_primitive* p = &prims[i];
-        gltf_set_packed(doc, p->mesh, p->primitive, &p->packed);
-        if (!args.compact) continue;
-        if (p->shared_with < 0) {
-            p->placeholder_joints = gltf_add_accessor(doc, NULL, p->skin.vertex_count,
-                                                      p->skin.joint_bytes == 1 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT,
-                                                      4, 0, 0);
-            p->placeholder_weights = gltf_add_accessor(doc, NULL, p->skin.vertex_count, GLTF_FLOAT, 4, 0, 0);
-        } else {
-            p->placeholder_joints = prims[p->shared_with].placeholder_joints;
-            p->placeholder_weights = prims[p->shared_with].placeholder_weights;
-        }
-        gltf_set_skin_attributes(doc, p->mesh, p->primitive, p->placeholder_joints, p->placeholder_weights);
-    }
-    if (count) gltf_declare_extension(doc, 1, args.compact);
-    if (count == 0) fprintf(stderr, "skinpack compress: %s: no skinned primitives; the file is copied\n", args.input);
-    if (args.compact && gltf_collect_garbage(doc, err, sizeof(err))) {
-        fprintf(stderr, "skinpack compress: %s: %s (use --fallback)\n", args.input, err);
+        fprintf(stderr, "skinpack compress: %s: no skinned primitives, nothing to compress; written unchanged to %s\n",
+                args.input, args.output);
+        rc = 0;
         goto done;
     }
+    /* Compact mode moves JOINTS_n/WEIGHTS_n out first, so that the packed arrays end the
+     * accessor and bufferView lists and decompress can take them away again without a trace. */
+    for (size_t i = 0; i < count && args.compact; ++i) make_compact(doc, &prims[i]);
+    if (compress_all(doc, &args, prims, count)) goto done;
+    gltf_declare_extension(doc, 1, args.compact);
     size_t output_bytes = 0;
     if (gltf_write_file(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &output_bytes, err,
                         sizeof(err))) {

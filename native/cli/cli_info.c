@@ -304,12 +304,9 @@ int skinpack_cmd_info(int argc, char** argv) {
                 fprintf(stderr, "skinpack info: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto done;
             }
-            if (count == capacity) {
-                capacity = capacity ? capacity * 2 : 16;
-                primitive_info* grown = realloc(infos, capacity * sizeof(*infos));
-                if (!grown) goto done;
-                infos = grown;
-            }
+            primitive_info* grown = cli_grow(infos, &capacity, count, sizeof(*infos));
+            if (!grown) goto done;
+            infos = grown;
             infos[count++] = info;
         }
     }

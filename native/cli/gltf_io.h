@@ -1,10 +1,13 @@
 /*
  * gltf_io.h - the small C view of a glTF document that the CLI commands work on.
  *
- * gltf_io.cpp implements it on top of tinygltf (the only C++ in the CLI). The commands never
- * see tinygltf types: they read skin attributes into flat arrays, hand flat arrays back as new
- * accessors and set or read the SKINPACK_packed_skin extension as a plain struct. Everything
- * read from a file is bounds-checked here, so a command can trust what it gets.
+ * gltf_read.cpp, gltf_extension.cpp and gltf_edit.cpp implement it (the only C++ in the CLI;
+ * gltf_doc.hpp). Reads go through tinygltf's model of the input; edits change the input's own
+ * JSON in place, so everything skinpack does not own is written back as it was read, and new
+ * binary data is appended. The commands never see tinygltf or JSON types: they read skin
+ * attributes into flat arrays, hand flat arrays back as accessors and set or read the
+ * SKINPACK_packed_skin extension as a plain struct. Everything read from a file is
+ * bounds-checked here, so a command can trust what it gets.
  *
  * Functions that can fail return 0 on success and -1 on failure, with a message in err
  * (err_size bytes, always NUL-terminated).
@@ -52,8 +55,8 @@ typedef struct gltf_skin_attributes {
     size_t vertex_count;
     size_t joint_count;              /* joints of the skin(s) whose nodes use this mesh; 0 if none */
     double stored_bits_per_vertex;   /* bits of all JOINTS_n + WEIGHTS_n elements, as stored */
-    int placeholder;                 /* 1: the accessors have no bufferView (compact mode: the data is in
-                                        SKINPACK_packed_skin, as KHR_draco_mesh_compression does it) */
+    int placeholder;                 /* 1: the accessors have no data (compact mode: they lie in a fallback
+                                        buffer, the data is in SKINPACK_packed_skin) */
 } gltf_skin_attributes;
 
 /*
@@ -88,6 +91,7 @@ typedef struct gltf_packed_skin {
     uint32_t method;          /* sp_method */
     uint64_t n;
     uint64_t axis_samples[3]; /* only for any: q2..qK */
+    uint32_t axis_sample_count; /* entries of "axisSamples" (0 when absent) */
     uint32_t weight_bits;
     uint32_t tuple_bits;
     double max_error;         /* informative */
@@ -122,44 +126,67 @@ int gltf_read_triangles(const gltf_doc* doc, size_t mesh, size_t primitive, uint
 int gltf_read_accessor_u32(const gltf_doc* doc, int accessor, int component_type, int components, size_t* count,
                            uint32_t* out, char* err, size_t err_size);
 
-/* ---- editing ---- */
+/* ---- editing (the input's JSON, changed in place; nothing is renumbered) ---- */
 
 #define GLTF_ACCESSOR_VERTEX_ATTRIBUTE 1 /* bufferView target ARRAY_BUFFER */
 #define GLTF_ACCESSOR_BOUNDS 2           /* write min/max computed from the data */
 
 /*
  * Appends an accessor over a new, 4-byte-aligned bufferView holding count elements of
- * components components each (tightly packed, little-endian). flags: GLTF_ACCESSOR_*.
- * data NULL makes an accessor without bufferView (a placeholder). Returns the accessor index.
+ * components components each (tightly packed, little-endian), appended to the file's binary
+ * data. flags: GLTF_ACCESSOR_*. data NULL puts the view in the fallback buffer (a buffer with
+ * no data, marked {"fallback": true} in the extension). Returns the accessor index.
  */
 int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, int component_type, int components,
                       int normalized, int flags);
 
-/* Writes the extension object on the primitive and adds the name to extensionsUsed. */
+/*
+ * Gives an existing accessor new data (its index, name, extras and extensions stay). When only
+ * this accessor uses its bufferView, the view is reused and its old bytes are cut from the
+ * buffer if skinpack writes that buffer (GLB BIN chunk, data: uri). Returns the bytes freed.
+ */
+size_t gltf_replace_accessor_data(gltf_doc* doc, int accessor, const void* data, size_t count, int component_type,
+                                  int components, int normalized, int flags);
+/* The same with data NULL: the accessor keeps its description, its data moves to the fallback
+ * buffer (compact mode). Returns the bytes freed. */
+size_t gltf_make_fallback(gltf_doc* doc, int accessor);
+
+/* Writes the extension object on the primitive / removes it. */
 void gltf_set_packed(gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed);
 void gltf_remove_packed(gltf_doc* doc, size_t mesh, size_t primitive);
 /* Removes JOINTS_n/WEIGHTS_n from the primitive. */
 void gltf_remove_skin_attributes(gltf_doc* doc, size_t mesh, size_t primitive);
-/* Sets JOINTS_0/WEIGHTS_0 (removing any JOINTS_n/WEIGHTS_n first). */
+/* Sets JOINTS_0/WEIGHTS_0 (removing any JOINTS_n/WEIGHTS_n with n > 0 first). */
 void gltf_set_skin_attributes(gltf_doc* doc, size_t mesh, size_t primitive, int joints, int weights);
 /* Adds or removes the extension name in extensionsUsed / extensionsRequired. */
 void gltf_declare_extension(gltf_doc* doc, int used, int required);
 
 /*
- * Drops accessors, bufferViews and buffer bytes nothing refers to any more, and packs all
- * remaining bufferViews into one buffer. Refuses (-1) when the file uses an extension that
- * might refer to accessors or bufferViews in a way this code does not know.
+ * Removes accessors at the end of the array that nothing refers to and that are listed in
+ * removable (the extension's, when decompress drops it), then their bufferViews and bytes.
+ * Does nothing when the file uses an extension whose references are unknown. Returns the
+ * bytes freed.
  */
-int gltf_collect_garbage(gltf_doc* doc, char* err, size_t err_size);
+size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, size_t removable_count);
 
-/* Serialises the document (.glb if binary, else .gltf with embedded buffers). The caller frees
- * *data with free(). */
+/* After decompress: accessors nothing uses that still lie in the input's fallback buffer lose
+ * their bufferView, and unused views there point at 4 new bytes, so the buffer can go. */
+void gltf_release_fallback(gltf_doc* doc);
+
+/* Serialises the document (.glb if binary, else .gltf with new data in data: uris). The caller
+ * frees *data with free(). */
 int gltf_serialize(const gltf_doc* doc, int binary, void** data, size_t* size, char* err, size_t err_size);
 
-/* Writes to path via a temporary file in the same folder, renamed only on success; no partial
- * file is left behind on failure. */
+/*
+ * Writes to path via a temporary file in the same folder, renamed only on success; no partial
+ * file is left behind on failure. Relative uris are rewritten to stay valid from path's folder.
+ */
 int gltf_write_file(const gltf_doc* doc, const char* path, int binary, size_t* bytes_written, char* err,
                     size_t err_size);
+/* For a document with nothing to change: copies the input's bytes exactly when path is of the
+ * same kind (and, for .gltf, in the same folder), else writes it as gltf_write_file does. */
+int gltf_write_unchanged(const gltf_doc* doc, const char* path, int binary, size_t* bytes_written, char* err,
+                         size_t err_size);
 
 #ifdef __cplusplus
 }

@@ -1,33 +1,32 @@
-"""File sizes and blend-attribute bits of the shared assets: Blender's export, skinpack, gltfpack.
+"""Whole-file sizes, GPU-resident skin bits and weight errors: original, gltfpack, Draco, skinpack.
 
-    python3 tests/bench/gltf_sizes.py --skinpack build/native/cli/skinpack --work DIR \
-        [--json OUT.json] ASSET.glb...
+    python3 tests/bench/gltf_sizes.py --skinpack build/native/cli/skinpack --tools tools \
+        --work DIR [--json OUT.json] ASSET.glb...
 
-Every variant is produced and measured in this run (nothing is copied from elsewhere):
-  source           the input: Blender's default export (tests/assets/export_blend_assets.py) or
+Every variant is produced and measured in this run (docs/benchmarks-gltf.md):
+  original         the input: Blender's default export (tests/assets/export_blend_assets.py) or
                    the file as shipped (Fox.glb)
+  gltfpack 1.3     gltfpack -cc (npm gltfpack 1.3: quantisation + EXT_meshopt_compression)
+  Draco            gltf-transform draco (glTF-Transform 4.5, its default Draco settings)
   skinpack         skinpack compress --compact (default budget: 32 bits a vertex, OSS)
-  skinpack fb      skinpack compress --fallback
-  gltfpack         gltfpack defaults (14-bit positions, 12-bit UVs, 8-bit normals; weights u8)
-  gltfpack hi      gltfpack -vp 16 -vt 16 -vn 16 (highest vertex precision)
-  gltfpack -cc     gltfpack -cc (EXT_meshopt_compression, higher ratio)
-  gltfpack+sp      skinpack compress --compact on the gltfpack default output
-For each: bytes, bytes after zlib (level 9) and zstd (level 19) of the whole file, stored bits a
-vertex of the blend attributes (JOINTS_n + WEIGHTS_n, or packed words + tuple table; from
-skinpack info), and the max weight error against the source's weights.
+  gltfpack+sp      gltfpack -cc, then skinpack compress --compact
+For each: bytes, bytes after gzip -9 and zstd -19 of the whole file, the skin's GPU-resident
+bits a vertex (JOINTS_n + WEIGHTS_n as their accessors decode, or packed words + tuple table;
+from skinpack info on the file, or on its decoded copy for Draco), and the max weight error
+against the original's weights. A last line per asset measures what meshopt-compressing
+skinpack's packed words would save (npm meshoptimizer's encodeVertexBuffer on them).
 
-Errors: skinpack outputs are decoded with skinpack decompress and compared vertex by vertex
-(joint-matched L-inf). gltfpack reorders and deduplicates vertices, so each of its vertices is
-compared with the nearest source vertex (in weights): that error is a lower bound (marked "≥"). gltfpack+sp is compared with the gltfpack output it was made from, and the
-gltfpack error is added (a bound for the sum, marked "≤"). -cc files cannot be read without a
-meshopt decoder: they hold the same quantised data as the default.
+Errors: skinpack is decoded with skinpack decompress and compared vertex by vertex (exact).
+gltfpack and Draco merge and reorder vertices, so each of their vertices is compared with the
+nearest original vertex (in weights): a lower bound (marked "≥"). gltfpack+sp is skinpack's exact
+error against the gltfpack weights plus that lower bound (marked "≈").
 """
 import argparse
 import json
 import os
 import subprocess
 import sys
-import zlib
+import gzip
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "cli"))
 import gltf_read  # noqa: E402
@@ -43,7 +42,7 @@ def run(cmd):
 def compressed_sizes(path):
     with open(path, "rb") as f:
         data = f.read()
-    z = len(zlib.compress(data, 9))
+    z = len(gzip.compress(data, 9, mtime=0))
     zs = len(subprocess.run(["zstd", "-19", "-c", "-q", path], capture_output=True, check=True).stdout)
     return len(data), z, zs
 
@@ -93,61 +92,102 @@ def error_nearest(reference, decoded):
     return worst
 
 
+def node_tool(args, script, *paths):
+    run([args.node, os.path.join(args.tools, script)] + list(paths))
+
+
+def packed_words_meshopt(args, path):
+    """(raw bytes, meshopt-encoded bytes) of the packed words of every primitive of path."""
+    script = os.path.join(args.work, "words_meshopt.mjs")
+    with open(script, "w") as f:
+        f.write(WORDS_MESHOPT % json.dumps(os.path.join(os.path.abspath(args.tools), "node_modules", "meshoptimizer",
+                                                        "index.js")))
+    return json.loads(run([args.node, script, path]))
+
+
+WORDS_MESHOPT = """
+import { readFileSync } from 'node:fs';
+const { MeshoptEncoder } = await import(%s);
+await MeshoptEncoder.ready;
+const file = readFileSync(process.argv[2]);
+const n = file.readUInt32LE(12), json = JSON.parse(file.subarray(20, 20 + n));
+const bin = file.subarray(20 + n + 8);
+const seen = new Set();
+let raw = 0, encoded = 0;
+for (const mesh of json.meshes) for (const p of mesh.primitives) {
+  const e = p.extensions && p.extensions.SKINPACK_packed_skin;
+  if (!e || seen.has(e.vertices)) continue;
+  seen.add(e.vertices);
+  const a = json.accessors[e.vertices], v = json.bufferViews[a.bufferView];
+  const words = bin.subarray(v.byteOffset || 0, (v.byteOffset || 0) + v.byteLength);
+  raw += v.byteLength;
+  encoded += MeshoptEncoder.encodeVertexBuffer(new Uint8Array(words), a.count, v.byteLength / a.count).length;
+}
+console.log(JSON.stringify([raw, encoded]));
+"""
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--skinpack", required=True)
-    parser.add_argument("--gltfpack", default="gltfpack")
+    parser.add_argument("--node", default="node")
+    parser.add_argument("--tools", required=True, help="tools/ with node_modules (npm ci)")
     parser.add_argument("--work", required=True)
     parser.add_argument("--json")
     parser.add_argument("assets", nargs="+")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     sp = args.skinpack
+    gltfpack = [args.node, os.path.join(args.tools, "node_modules", "gltfpack", "cli.js")]
+    transform = [args.node, os.path.join(args.tools, "node_modules", "@gltf-transform", "cli", "bin", "cli.js")]
     rows = []
     for asset in args.assets:
         name = os.path.splitext(os.path.basename(asset))[0]
         w = lambda tag: os.path.join(args.work, "%s.%s.glb" % (name, tag))  # noqa: E731
         reference = skin_influences(asset)
-        variants = []
 
-        def add(label, path, error, error_kind=""):
+        def add(label, path, bits_path, error, error_kind=""):
             size, z, zs = compressed_sizes(path)
-            bits, vertices = stored_bits(sp, path) if not label.endswith("-cc") else (None, None)
-            variants.append({"asset": name, "variant": label, "bytes": size, "zlib": z, "zstd": zs,
-                             "blend_bits_per_vertex": bits, "max_weight_error": error, "error_kind": error_kind})
+            bits, _ = stored_bits(sp, bits_path)
+            rows.append({"asset": name, "variant": label, "bytes": size, "gzip": z, "zstd": zs,
+                         "gpu_bits_per_vertex": bits, "max_weight_error": error, "error_kind": error_kind})
 
-        add("source", asset, 0.0)
+        add("original", asset, asset, 0.0)
+        run(gltfpack + ["-i", asset, "-o", w("gltfpack"), "-cc"])
+        node_tool(args, "meshopt_unpack.mjs", w("gltfpack"), w("gltfpack.plain"))
+        gp_error = error_nearest(reference, skin_influences(w("gltfpack.plain")))
+        add("gltfpack 1.3 -cc", w("gltfpack"), w("gltfpack"), gp_error, "≥")
+        run(transform + ["draco", asset, w("draco")])
+        node_tool(args, "gltf_plain.mjs", w("draco"), w("draco.plain"))
+        add("Draco (glTF-Transform)", w("draco"), w("draco.plain"),
+            error_nearest(reference, skin_influences(w("draco.plain"))), "≥")
         run([sp, "compress", asset, "-o", w("skinpack"), "--compact"])
         run([sp, "decompress", w("skinpack"), "-o", w("skinpack.decoded")])
-        sp_error = error_same_order(reference, skin_influences(w("skinpack.decoded")))
-        add("skinpack", w("skinpack"), sp_error)
-        run([sp, "compress", asset, "-o", w("skinpack_fb"), "--fallback"])
-        add("skinpack fb", w("skinpack_fb"), sp_error)
-        gp_error = None
-        for label, tag, options in [("gltfpack", "gltfpack", []),
-                                    ("gltfpack hi", "gltfpack_hi", ["-vp", "16", "-vt", "16", "-vn", "16"]),
-                                    ("gltfpack -cc", "gltfpack_cc", ["-cc"])]:
-            run([args.gltfpack, "-i", asset, "-o", w(tag)] + options)
-            if label == "gltfpack -cc":
-                add(label, w(tag), gp_error, "≥")
-                continue
-            error = error_nearest(reference, skin_influences(w(tag)))
-            if label == "gltfpack":
-                gp_error = error
-            add(label, w(tag), error, "≥")
+        add("skinpack", w("skinpack"), w("skinpack"), error_same_order(reference, skin_influences(w("skinpack.decoded"))))
         run([sp, "compress", w("gltfpack"), "-o", w("gltfpack_sp"), "--compact"])
         run([sp, "decompress", w("gltfpack_sp"), "-o", w("gltfpack_sp.decoded")])
-        on_top = error_same_order(skin_influences(w("gltfpack")), skin_influences(w("gltfpack_sp.decoded")))
-        add("gltfpack+sp", w("gltfpack_sp"), on_top + gp_error, "≤")
-        rows += variants
+        node_tool(args, "meshopt_unpack.mjs", w("gltfpack_sp.decoded"), w("gltfpack_sp.decoded.plain"))
+        on_top = error_same_order(skin_influences(w("gltfpack.plain")), skin_influences(w("gltfpack_sp.decoded.plain")))
+        add("gltfpack -cc, then skinpack", w("gltfpack_sp"), w("gltfpack_sp"), on_top + gp_error, "≈")
+        raw, encoded = packed_words_meshopt(args, w("gltfpack_sp"))
+        rows[-1]["packed_words_bytes"], rows[-1]["packed_words_meshopt_bytes"] = raw, encoded
 
-    print("| asset | variant | bytes | zlib -9 | zstd -19 | blend bits/vertex | max weight error |")
+    print("| asset | variant | bytes | gzip -9 | zstd -19 | GPU skin bits/vertex | max weight error |")
     print("|---|---|---:|---:|---:|---:|---:|")
     for r in rows:
-        bits = "%.1f" % r["blend_bits_per_vertex"] if r["blend_bits_per_vertex"] is not None else "n/a"
         error = "%s%.2e" % (r["error_kind"], r["max_weight_error"]) if r["max_weight_error"] else "0"
-        print("| %s | %s | %d | %d | %d | %s | %s |" % (r["asset"], r["variant"], r["bytes"], r["zlib"], r["zstd"],
-                                                       bits, error))
+        print("| %s | %s | %d | %d | %d | %.1f | %s |" % (r["asset"], r["variant"], r["bytes"], r["gzip"], r["zstd"],
+                                                        r["gpu_bits_per_vertex"], error))
+    print()
+    print("| asset | packed words (gltfpack+sp) | meshopt-encoded | saved | gltfpack+sp with it | gltfpack alone |")
+    print("|---|---:|---:|---:|---:|---:|")
+    by = {(r["asset"], r["variant"]): r for r in rows}
+    for r in rows:
+        if "packed_words_bytes" not in r:
+            continue
+        saved = r["packed_words_bytes"] - r["packed_words_meshopt_bytes"]
+        print("| %s | %d | %d | %d | %d | %d |" % (r["asset"], r["packed_words_bytes"], r["packed_words_meshopt_bytes"],
+                                                   saved, r["bytes"] - saved, by[(r["asset"], "gltfpack 1.3 -cc")]["bytes"]))
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -14,7 +14,8 @@ CHECK is one of
   meshlets   compress --meshlets: every source triangle is in exactly one meshlet (same winding),
              every meshlet vertex's palette joints are the decoded joints of its source vertex,
              limits hold, and the stored counts match compress --json
-Anything after ASSET is passed to skinpack compress (e.g. --method pot --weight-bits 20).
+--reference PLAIN.glb: ASSET as decoded by another decoder (gltfpack -cc files: meshopt), read as
+the reference instead of ASSET. Anything after ASSET is passed to skinpack compress (e.g. --method pot --weight-bits 20).
 """
 import argparse
 import json
@@ -89,7 +90,7 @@ def check_validate(args, extra):
 
 def check_roundtrip(args, extra):
     base = outputs(args, extra)
-    original = gltf_read.Gltf(args.asset)
+    original = gltf_read.Gltf(args.reference or args.asset)
     for mode, ext in (("compact", ".glb"), ("fallback", ".glb"), ("compact", ".gltf")):
         packed_path = base + "_rt_%s%s" % (mode, ext)
         decoded_path = base + "_rt_%s_decoded%s" % (mode, ext)
@@ -195,7 +196,7 @@ def check_meshlets(args, extra):
     decoded_path = base + "_meshlets_decoded.glb"
     report = compress(args, "compact", path, extra + ["--meshlets"])
     run([args.skinpack, "decompress", path, "-o", decoded_path])
-    original, packed, decoded = gltf_read.Gltf(args.asset), gltf_read.Gltf(path), gltf_read.Gltf(decoded_path)
+    original, packed, decoded = gltf_read.Gltf(args.reference or args.asset), gltf_read.Gltf(path), gltf_read.Gltf(decoded_path)
     rows = {(r["mesh"], r["primitive"]): r for r in report["primitives"]}
     for m, p, prim in original.primitives():
         if "JOINTS_0" not in prim["attributes"]:
@@ -243,6 +244,8 @@ def main():
     parser.add_argument("--node", default="node")
     parser.add_argument("--validator", required=True)
     parser.add_argument("--work", required=True)
+    parser.add_argument("--reference", help="the asset without EXT_meshopt_compression (tools/meshopt_unpack.mjs), "
+                        "read instead of ASSET by this independent reader")
     parser.add_argument("asset")
     args, extra = parser.parse_known_args()
     os.makedirs(args.work, exist_ok=True)

@@ -75,13 +75,25 @@ def view_past_buffer(d, b):
     d["bufferViews"][acc["bufferView"]]["byteOffset"] = len(b) - 8
 
 
-def requires_meshopt(d, b):
+def requires_draco(d, b):
+    d.setdefault("extensionsUsed", []).append("KHR_draco_mesh_compression")
+    d.setdefault("extensionsRequired", []).append("KHR_draco_mesh_compression")
+
+
+def broken_meshopt(d, b):
+    """JOINTS_0's view claims meshopt-compressed bytes that are not (16 bytes of the file)."""
     d.setdefault("extensionsUsed", []).append("EXT_meshopt_compression")
     d.setdefault("extensionsRequired", []).append("EXT_meshopt_compression")
+    accessor = d["accessors"][skinned(d)["attributes"]["JOINTS_0"]]
+    view = d["bufferViews"][accessor["bufferView"]]
+    view.setdefault("extensions", {})["EXT_meshopt_compression"] = {
+        "buffer": 0, "byteOffset": 0, "byteLength": 16, "byteStride": 8, "count": accessor["count"],
+        "mode": "ATTRIBUTES"}
 
 
 STANDARD = [
-    ("requires-meshopt", "EXT_meshopt_compression", requires_meshopt),
+    ("requires-draco", "Draco", requires_draco),
+    ("broken-meshopt", "does not decode", broken_meshopt),
     ("nan-weight", "finite", weights_value(float("nan"))),
     ("negative-weight", "negative", weights_value(-0.25)),
     ("joints-without-weights", "without WEIGHTS_0", drop_weights),
@@ -148,7 +160,7 @@ PACKED = [
     ("tuple-bits-mismatch", "tupleBits", set_field("tupleBits", 3)),
     ("unknown-method", "method", set_field("method", "zip")),
     ("influences-5", "influences", set_field("influences", 5)),
-    ("n-zero", "codec", set_field("n", 0)),
+    ("n-zero", "n: 0 out of range", set_field("n", 0)),
     ("vertices-missing", "does not exist", set_field("vertices", 100000)),
     ("joint-count-past-skin", "jointCount", set_field("jointCount", 200)),
     ("extension-not-an-object", "no data", lambda d, b: skinned(d)["extensions"].__setitem__(EXT, [1, 2])),
@@ -250,6 +262,20 @@ def main():
         json.dump(missing, f)
     failures += ["missing-buffer: %s" % p for p in
                  expect_failure([args.skinpack, "compress", path, "-o", out], "missing.bin", out, args.work)]
+
+    # A folder instead of a file (it used to abort with an uncaught C++ exception).
+    for command in ("info", "compress", "decompress"):
+        cmd = [args.skinpack, command, args.work] + (["-o", out] if command != "info" else [])
+        failures += ["folder: %s" % p for p in expect_failure(cmd, "is a folder", out if command != "info" else None,
+                                                              args.work)]
+
+    # Option mistakes are reported as option errors, naming the option.
+    for option, value in (("--weight-bits", "99"), ("--vertex-bits", "0"), ("--max-influences", "9"),
+                          ("--method", "zip"), ("--max-error", "2")):
+        cmd = [args.skinpack, "compress", args.asset, "-o", out, option, value]
+        result = subprocess.run(cmd, capture_output=True, text=True)
+        if result.returncode != 2 or option not in result.stderr or os.path.exists(out):
+            failures.append("option %s %s: exit %d, %r" % (option, value, result.returncode, result.stderr.strip()))
 
     # An output folder that does not exist: error, and nothing half-written anywhere.
     bad_out = os.path.join(args.work, "no-such-dir", "out.glb")

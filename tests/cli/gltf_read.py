@@ -31,10 +31,10 @@ class Gltf:
         else:
             self.json = json.loads(data)
         self.buffers = []
-        for buffer in self.json.get("buffers", []):
+        for index, buffer in enumerate(self.json.get("buffers", [])):
             uri = buffer.get("uri")
-            if uri is None:
-                self.buffers.append(self.bin)
+            if uri is None:  # the GLB chunk; other buffers without uri have no data (fallback buffers)
+                self.buffers.append(self.bin if index == 0 else None)
             elif uri.startswith("data:"):
                 self.buffers.append(base64.b64decode(uri.split(",", 1)[1]))
             else:
