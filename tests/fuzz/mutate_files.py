@@ -12,9 +12,9 @@ message and no output file, or write a file that the Khronos validator passes, w
 extension, whose decoded joints are all below the joint count of the skin and distinct wherever
 weighted.
 
-Not registered in ctest yet: the CLI does not call sp_validate_packed (issue 10 wires it), and
-until then this script reports the reader holes it finds (today: a `vertices` accessor shorter
-than the primitive is decoded and written).
+In ctest as cli_mutate_files (Fox and skinned_cylinder). It fails while the CLI passes the
+`vertices` accessor's count as the primitive's vertex count to sp_validate_packed (a `vertices`
+accessor one shorter than POSITION is decoded and written: "vertices count - 1").
 """
 import copy
 import json
