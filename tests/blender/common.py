@@ -264,3 +264,19 @@ def rigged_grid(name, bone_count, influences, subdivisions=0):
         bpy.ops.object.modifier_apply(modifier=modifier.name)
     obj.modifiers.new("Armature", 'ARMATURE').object = armature
     return obj
+
+
+def weight_totals(pairs):
+    """({key: sum of weights}, {key: how many}) over (key, weight) pairs with a non-zero weight."""
+    sums, counts = {}, {}
+    for key, weight in pairs:
+        if weight > 0:
+            sums[key] = sums.get(key, 0.0) + weight
+            counts[key] = counts.get(key, 0) + 1
+    return sums, counts
+
+
+def vertex_group_weights(obj):
+    """(vertex group name, weight) of every vertex's group elements."""
+    names = [g.name for g in obj.vertex_groups]
+    return ((names[e.group], e.weight) for vertex in obj.data.vertices for e in vertex.groups)

@@ -73,25 +73,15 @@ def import_valid(name):
     # Blender names a nameless node Node_<index>.
     joint_names = [glb.json["nodes"][j].get("name") or "Node_%d" % j for j in glb.json["skins"][0]["joints"]]
     joints, weights = expected_maps(name)
-    expected_sum, expected_count = {}, {}
-    for joint_row, weight_row in zip(joints.tolist(), weights.tolist()):
-        for joint, weight in zip(joint_row, weight_row):
-            if weight > 0:
-                expected_sum[joint_names[joint]] = expected_sum.get(joint_names[joint], 0.0) + weight
-                expected_count[joint_names[joint]] = expected_count.get(joint_names[joint], 0) + 1
+    expected_sum, expected_count = common.weight_totals(
+        (joint_names[joint], weight) for joint_row, weight_row in zip(joints.tolist(), weights.tolist())
+        for joint, weight in zip(joint_row, weight_row))
     existing = set(bpy.data.objects)
     bpy.ops.import_scene.gltf(filepath=os.path.join(EXAMPLES, name + ".glb"))
     imported = [o for o in bpy.data.objects if o not in existing and o.type == 'MESH']
     common.check(len(imported) == 1, "%s: %d meshes imported" % (name, len(imported)))
     obj = imported[0]
-    group_names = [g.name for g in obj.vertex_groups]
-    got_sum, got_count = {}, {}
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            if element.weight > 0:
-                key = group_names[element.group]
-                got_sum[key] = got_sum.get(key, 0.0) + element.weight
-                got_count[key] = got_count.get(key, 0) + 1
+    got_sum, got_count = common.weight_totals(common.vertex_group_weights(obj))
     common.check(got_count == expected_count, "%s: influence counts %s, expected %s" % (name, got_count, expected_count))
     worst = max(abs(got_sum[k] - expected_sum[k]) for k in expected_sum)
     common.check(worst < 1e-5, "%s: weight sums differ by %g" % (name, worst))
