@@ -3,7 +3,7 @@
 The spec's example files (docs/extension/conformance/examples) import with their expected
 decoded weights. Copies broken in one way each (a code outside the simplex, a joint weighted
 in two slots, a wrong vertex count, integers a reader must not truncate, a skin smaller than
-jointCount, primitives sharing the packed words with other properties, a broken meshlet) must
+jointCount, primitives sharing the packed words with other properties, broken meshlets) must
 stop the import with a message naming the file, mesh, primitive and the library's reason, and
 leave the scene without a new object, mesh or armature.
 """
@@ -175,6 +175,12 @@ def corrupt_files(out):
     def meshlet_vertex(glb):
         glb.set_row(glb.extension()["meshlets"]["vertices"], 0, [1000])
     case("meshlets_fixed", "meshlet_vertex", meshlet_vertex, "meshlets.vertices: index 1000 not below 6")
+
+    # Local tuple tables must be K wide (VEC3 here): a SCALAR accessor is refused by its type.
+    def meshlet_tuples_type(glb):
+        glb.json["accessors"][glb.extension()["meshlets"]["tuples"]]["type"] = "SCALAR"
+        return ["meshlets.tuples: accessor %d is SCALAR, expected VEC3" % glb.extension()["meshlets"]["tuples"]]
+    case("meshlets_fixed", "meshlet_tuples_type", meshlet_tuples_type)
     return cases
 
 

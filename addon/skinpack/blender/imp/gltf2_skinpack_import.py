@@ -34,14 +34,14 @@ class _Refusal(Exception):
 # Component types the glTF layer accepts per array (the library checks the widths it implies).
 _WORD_TYPES = (ext.COMPONENT_UNSIGNED_INT,)
 _TABLE_TYPES = (ext.COMPONENT_UNSIGNED_BYTE, ext.COMPONENT_UNSIGNED_SHORT)
-# meshlets property -> (the library's array name, component type).
-_MESHLET_ACCESSORS = {"offsets": ("offsets", ext.COMPONENT_UNSIGNED_INT),
-                      "counts": ("counts", ext.COMPONENT_UNSIGNED_SHORT),
-                      "vertices": ("vertices", ext.COMPONENT_UNSIGNED_INT),
-                      "vertexTuples": ("vertex_tuples", ext.COMPONENT_UNSIGNED_BYTE),
-                      "triangles": ("triangles", ext.COMPONENT_UNSIGNED_BYTE),
-                      "joints": ("joints", ext.COMPONENT_UNSIGNED_SHORT),
-                      "tuples": ("tuples", ext.COMPONENT_UNSIGNED_BYTE)}
+# meshlets property -> (the library's array name, component type, components; None: K).
+_MESHLET_ACCESSORS = {"offsets": ("offsets", ext.COMPONENT_UNSIGNED_INT, 4),
+                      "counts": ("counts", ext.COMPONENT_UNSIGNED_SHORT, 4),
+                      "vertices": ("vertices", ext.COMPONENT_UNSIGNED_INT, 1),
+                      "vertexTuples": ("vertex_tuples", ext.COMPONENT_UNSIGNED_BYTE, 1),
+                      "triangles": ("triangles", ext.COMPONENT_UNSIGNED_BYTE, 1),
+                      "joints": ("joints", ext.COMPONENT_UNSIGNED_SHORT, 1),
+                      "tuples": ("tuples", ext.COMPONENT_UNSIGNED_BYTE, None)}
 _MESHLET_LIMITS = {"maxVertices": "max_vertices", "maxTriangles": "max_triangles", "maxJoints": "max_joints"}
 
 
@@ -63,7 +63,7 @@ def _accessor(gltf, index, name, component_types):
         raise _Refusal("%s: accessor %d lies outside its bufferView or buffer (%s)" % (name, index, error)) from None
 
 
-def _meshlets(gltf, extension):
+def _meshlets(gltf, extension, influences):
     """The meshlet arrays and limits as native.validate_packed takes them, or None."""
     meshlets = extension.get("meshlets")
     if meshlets is None:
@@ -71,10 +71,14 @@ def _meshlets(gltf, extension):
     if not isinstance(meshlets, dict):
         raise _Refusal("meshlets: not an object")
     arrays = {}
-    for name, (field, component_type) in _MESHLET_ACCESSORS.items():
+    for name, (field, component_type, components) in _MESHLET_ACCESSORS.items():
         if name not in meshlets:
             raise _Refusal("meshlets.%s is missing" % name)
-        arrays[field] = _accessor(gltf, meshlets[name], "meshlets." + name, (component_type,))[1]
+        accessor, arrays[field] = _accessor(gltf, meshlets[name], "meshlets." + name, (component_type,))
+        expected = ext.VECTOR_TYPES.get(components or influences)
+        if accessor.type != expected:
+            raise _Refusal("meshlets.%s: accessor %d is %s, expected %s" % (name, meshlets[name], accessor.type,
+                                                                             expected))
     for name, field in _MESHLET_LIMITS.items():
         if name in meshlets:
             arrays[field] = native.json_integer(meshlets[name], "meshlets." + name, bits=32)
@@ -104,7 +108,7 @@ def validate_primitive(gltf, mesh_index, primitive, extension):
         joints, weights, _ = native.validate_packed(
             params, words, words.shape[1], gltf.data.accessors[position].count, table,
             1 if table_accessor.component_type == ext.COMPONENT_UNSIGNED_BYTE else 2,
-            _skin_joint_count(gltf, mesh_index), _meshlets(gltf, extension))
+            _skin_joint_count(gltf, mesh_index), _meshlets(gltf, extension, int(params.influences)))
     except native.SkinpackError as error:
         raise _Refusal(str(error)) from None
     return params, joints, weights
