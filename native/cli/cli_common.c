@@ -15,9 +15,9 @@ static int fail(char* err, size_t err_size, const char* format, ...) {
     return -1;
 }
 
-int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
-                             uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
-                             size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
+static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
+                         uint32_t words_per_vertex, size_t primitive_vertex_count, const uint16_t* lut, size_t lut_size,
+                         size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
     memset(out, 0, sizeof(*out));
     /* Every format rule is the library's (sp_validate_packed); this only passes what the file says. */
     sp_packed_primitive primitive;
@@ -37,7 +37,7 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
     primitive.words = words;
     primitive.vertex_count = vertex_count;
     primitive.words_per_vertex = words_per_vertex;
-    primitive.primitive_vertex_count = vertex_count; /* checked against POSITION by the caller's reader */
+    primitive.primitive_vertex_count = primitive_vertex_count;
     primitive.lut = lut;
     primitive.lut_size = lut_size;
     primitive.lut_components = packed->influences;
@@ -66,8 +66,15 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
     return 0;
 }
 
-int cli_decode_packed(const gltf_doc* doc, size_t mesh, const gltf_packed_skin* packed, cli_decoded_skin* out,
-                      char* err, size_t err_size) {
+int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
+                             uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
+                             size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
+    return decode_arrays(packed, words, vertex_count, words_per_vertex, vertex_count, lut, lut_size, skin_joint_count,
+                         out, err, err_size);
+}
+
+int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
+                      cli_decoded_skin* out, char* err, size_t err_size) {
     size_t vertex_count = 0, lut_size = 0;
     uint32_t words_per_vertex = 0;
     memset(out, 0, sizeof(*out));
@@ -78,8 +85,9 @@ int cli_decode_packed(const gltf_doc* doc, size_t mesh, const gltf_packed_skin* 
     if (!words || !lut)
         fail(err, err_size, "out of memory");
     else if (gltf_read_packed(doc, packed, words, lut, err, err_size) == 0) {
-        rc = cli_decode_packed_arrays(packed, words, vertex_count, words_per_vertex, lut, lut_size,
-                                      gltf_mesh_joint_count(doc, mesh), out, err, err_size);
+        size_t primitive_vertices = gltf_primitive_vertex_count(doc, mesh, primitive);
+        rc = decode_arrays(packed, words, vertex_count, words_per_vertex, primitive_vertices ? primitive_vertices : vertex_count,
+                           lut, lut_size, gltf_mesh_joint_count(doc, mesh), out, err, err_size);
     }
     free(words);
     free(lut);

@@ -40,14 +40,16 @@ typedef struct compressed_primitive {
  * to load the buffer instead of reading zeros, one with it fills them from the packed data.
  * JOINTS_1/WEIGHTS_1 go (the packed skin has at most 4 influences). The freed bytes are cut.
  */
-static void make_compact(gltf_doc* doc, const compressed_primitive* p) {
+static size_t make_compact(gltf_doc* doc, const compressed_primitive* p) {
     const gltf_skin_attributes* at = &p->attributes;
     gltf_set_skin_attributes(doc, p->mesh, p->primitive, at->joints[0], at->weights[0]);
-    if (p->shared_with >= 0) return; /* the first primitive with these accessors moved them */
+    if (p->shared_with >= 0) return 0; /* the first primitive with these accessors moved them */
+    size_t freed = 0;
     for (size_t s = 0; s < at->sets; ++s) {
-        gltf_make_fallback(doc, at->joints[s]);
-        gltf_make_fallback(doc, at->weights[s]);
+        freed += gltf_make_fallback(doc, at->joints[s]);
+        freed += gltf_make_fallback(doc, at->weights[s]);
     }
+    return freed;
 }
 
 static void compress_usage(FILE* out) {
@@ -630,7 +632,12 @@ int skinpack_cmd_compress(int argc, char** argv) {
     }
     /* Compact mode moves JOINTS_n/WEIGHTS_n out first, so that the packed arrays end the
      * accessor and bufferView lists and decompress can take them away again without a trace. */
-    for (size_t i = 0; i < count && args.compact; ++i) make_compact(doc, &prims[i]);
+    size_t freed = 0;
+    for (size_t i = 0; i < count && args.compact; ++i) freed += make_compact(doc, &prims[i]);
+    if (args.compact && freed == 0)
+        fprintf(stderr, "skinpack compress: %s: warning: the old JOINTS_n/WEIGHTS_n bytes stay in the file (they are "
+                "in an external buffer, shared, or the file uses an extension whose references skinpack does not "
+                "know); the file is correct but not smaller\n", args.input);
     if (compress_all(doc, &args, prims, count)) goto done;
     gltf_declare_extension(doc, 1, args.compact);
     size_t output_bytes = 0;

@@ -117,7 +117,7 @@ static long decode_all(gltf_doc* doc, const char* input, decoded_primitive** out
                 if (list[i].shared_with < 0 && list[i].packed.vertices == packed.vertices &&
                     list[i].packed.tuple_table == packed.tuple_table)
                     d->shared_with = (long)i;
-            if (d->shared_with < 0 && cli_decode_packed(doc, m, &packed, &d->skin, err, sizeof(err))) {
+            if (d->shared_with < 0 && cli_decode_packed(doc, m, p, &packed, &d->skin, err, sizeof(err))) {
                 fprintf(stderr, "skinpack decompress: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto fail;
             }

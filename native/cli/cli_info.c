@@ -104,7 +104,7 @@ done:
 static int info_packed(const gltf_doc* doc, size_t mesh, size_t primitive, primitive_info* info, char* err,
                        size_t err_size) {
     cli_decoded_skin skin;
-    if (cli_decode_packed(doc, mesh, &info->ext, &skin, err, err_size)) return -1;
+    if (cli_decode_packed(doc, mesh, primitive, &info->ext, &skin, err, err_size)) return -1;
     uint32_t k = skin.influences;
     info->packed = 1;
     info->vertices = skin.vertex_count;

@@ -110,6 +110,9 @@ int gltf_packed_sizes(const gltf_doc* doc, const gltf_packed_skin* packed, size_
 int gltf_read_packed(const gltf_doc* doc, const gltf_packed_skin* packed, uint32_t* words, uint16_t* lut,
                      char* err, size_t err_size);
 
+/* The primitive's POSITION count (0 when it has no valid POSITION accessor). */
+size_t gltf_primitive_vertex_count(const gltf_doc* doc, size_t mesh, size_t primitive);
+
 /* Triangle-list geometry of a primitive: index count (vertex count when not indexed) and the
  * POSITION accessor. Fails for modes other than TRIANGLES. */
 int gltf_primitive_triangles(const gltf_doc* doc, size_t mesh, size_t primitive, size_t* index_count,

@@ -496,6 +496,12 @@ extern "C" int gltf_read_skin(const gltf_doc* doc, const gltf_skin_attributes* a
 
 // ---- geometry and generic accessors ----
 
+extern "C" size_t gltf_primitive_vertex_count(const gltf_doc* doc, size_t mesh, size_t primitive) {
+    int position = find_attribute(doc->model.meshes[mesh].primitives[primitive], "POSITION");
+    if (position < 0 || size_t(position) >= doc->model.accessors.size()) return 0;
+    return doc->model.accessors[size_t(position)].count;
+}
+
 extern "C" int gltf_primitive_triangles(const gltf_doc* doc, size_t mesh, size_t primitive, size_t* index_count,
                                         size_t* vertex_count, char* err, size_t err_size) {
     const tinygltf::Model& model = doc->model;

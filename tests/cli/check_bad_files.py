@@ -160,7 +160,7 @@ PACKED = [
     ("tuple-bits-mismatch", "tupleBits", set_field("tupleBits", 3)),
     ("unknown-method", "method", set_field("method", "zip")),
     ("influences-5", "influences", set_field("influences", 5)),
-    ("n-zero", "n: 0 out of range", set_field("n", 0)),
+    ("n-zero", "n: 0 below the minimum", set_field("n", 0)),
     ("vertices-missing", "does not exist", set_field("vertices", 100000)),
     ("joint-count-past-skin", "jointCount", set_field("jointCount", 200)),
     ("extension-not-an-object", "no data", lambda d, b: skinned(d)["extensions"].__setitem__(EXT, [1, 2])),
