@@ -12,9 +12,7 @@ message and no output file, or write a file that the Khronos validator passes, w
 extension, whose decoded joints are all below the joint count of the skin and distinct wherever
 weighted.
 
-In ctest as cli_mutate_files (Fox and skinned_cylinder). It fails while the CLI passes the
-`vertices` accessor's count as the primitive's vertex count to sp_validate_packed (a `vertices`
-accessor one shorter than POSITION is decoded and written: "vertices count - 1").
+In ctest as cli_mutate_files (tests/cli/CMakeLists.txt: Fox and skinned_cylinder).
 """
 import copy
 import json
