@@ -82,7 +82,8 @@ def import_valid(name):
     common.check(len(imported) == 1, "%s: %d meshes imported" % (name, len(imported)))
     obj = imported[0]
     got_sum, got_count = common.weight_totals(common.vertex_group_weights(obj))
-    common.check(got_count == expected_count, "%s: influence counts %s, expected %s" % (name, got_count, expected_count))
+    common.check(got_count == expected_count, "%s: influence counts %s, expected %s"
+                 % (name, got_count, expected_count))
     worst = max(abs(got_sum[k] - expected_sum[k]) for k in expected_sum)
     common.check(worst < 1e-5, "%s: weight sums differ by %g" % (name, worst))
     print("%s: imports with the expected weights of %d joints" % (name, len(expected_sum)))

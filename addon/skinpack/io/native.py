@@ -374,7 +374,8 @@ def packed_params(extension):
     params.n = json_integer(extension.get("n"), "n", strings=True)
     samples = extension.get("axisSamples", [])
     if not isinstance(samples, list) or len(samples) > len(params.axis_samples):
-        raise SkinpackError("axisSamples: %r is not a list of at most %d integers" % (samples, len(params.axis_samples)))
+        raise SkinpackError("axisSamples: %r is not a list of at most %d integers"
+                            % (samples, len(params.axis_samples)))
     for axis, value in enumerate(samples):
         params.axis_samples[axis] = json_integer(value, "axisSamples[%d]" % axis, strings=True)
     params.axis_sample_count = len(samples)
