@@ -41,7 +41,7 @@ static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, 
     primitive.lut = lut;
     primitive.lut_size = lut_size;
     primitive.lut_components = packed->influences;
-    primitive.lut_component_bytes = packed->joint_count <= 256 ? 1 : 2; /* gltf_packed_sizes checked the type */
+    primitive.lut_component_bytes = sp_joint_bytes(packed->joint_count); /* gltf_packed_sizes checked the type */
     primitive.skin_joint_count = skin_joint_count;
 
     uint32_t k = packed->influences;

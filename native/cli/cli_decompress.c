@@ -62,7 +62,7 @@ static int write_standard(gltf_doc* doc, const decoded_primitive* d, int* joints
             joints16[v * 4 + i] = w > 0 ? skin->joints[v * k + i] : 0;
         }
     const int flags = GLTF_ACCESSOR_VERTEX_ATTRIBUTE | GLTF_ACCESSOR_BOUNDS;
-    int joint_type = d->packed.joint_count <= 256 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT; /* the u8/u16 rule */
+    int joint_type = sp_joint_bytes(d->packed.joint_count) == 1 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT;
     if (joint_type == GLTF_UNSIGNED_BYTE) {
         uint8_t* joints8 = (uint8_t*)joints16;
         for (size_t i = 0; i < vc * 4; ++i) joints8[i] = (uint8_t)joints16[i];

@@ -27,26 +27,15 @@ static int json_integer(const tinygltf::Value& object, const char* key, double l
 // n and axisSamples entries reach 2^63: a JSON integer up to 2^53, a string of decimal digits
 // above (docs/extension: "Large integers").
 static int json_large_integer(const tinygltf::Value& value, uint64_t* out) {
-    const double max_safe = 9007199254740992.0; // 2^53
     if (value.IsNumber()) {
         double d = value.GetNumberAsDouble();
-        if (!std::isfinite(d) || d != std::floor(d) || d < 0 || d > max_safe) return -1;
+        if (!std::isfinite(d) || d != std::floor(d) || d < 0 || d > double(SP_JSON_MAX_SAFE_INTEGER)) return -1;
         *out = uint64_t(d);
         return 0;
     }
     if (!value.IsString()) return -1;
     const std::string& text = value.Get<std::string>();
-    if (text.empty() || text.size() > 20 || text[0] == '0') return -1;
-    uint64_t v = 0;
-    for (char c : text) {
-        if (c < '0' || c > '9') return -1;
-        uint64_t digit = uint64_t(c - '0');
-        if (v > (UINT64_MAX - digit) / 10) return -1;
-        v = v * 10 + digit;
-    }
-    if (v <= uint64_t(max_safe)) return -1;
-    *out = v;
-    return 0;
+    return sp_parse_decimal(text.data(), text.size(), out) == SP_OK ? 0 : -1; // the library's rule
 }
 
 extern "C" int gltf_get_packed(const gltf_doc* doc, size_t mesh, size_t primitive, gltf_packed_skin* packed,
@@ -138,7 +127,7 @@ extern "C" int gltf_packed_sizes(const gltf_doc* doc, const gltf_packed_skin* pa
         (words_type != TINYGLTF_TYPE_SCALAR && words_type != TINYGLTF_TYPE_VEC2))
         return fail(err, err_size, GLTF_EXTENSION_NAME ": the vertices accessor must be UNSIGNED_INT SCALAR or VEC2");
     int lut_type = model.accessors[size_t(packed->tuple_table)].type;
-    int want = packed->joint_count <= 256 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT;
+    int want = sp_joint_bytes(packed->joint_count) == 1 ? GLTF_UNSIGNED_BYTE : GLTF_UNSIGNED_SHORT;
     if (lut.component_type != want || lut.normalized || lut_type != gltf_type_for_components(int(packed->influences)))
         return fail(err, err_size, GLTF_EXTENSION_NAME ": the tupleTable accessor must be %s with %u components",
                     want == GLTF_UNSIGNED_BYTE ? "UNSIGNED_BYTE" : "UNSIGNED_SHORT", packed->influences);
@@ -166,7 +155,7 @@ extern "C" int gltf_read_packed(const gltf_doc* doc, const gltf_packed_skin* pac
 
 // A JSON integer up to 2^53, else a string of its digits (docs/extension: "Large integers").
 static ordered_json large_integer(uint64_t v) {
-    if (v <= (uint64_t(1) << 53)) return v;
+    if (v <= SP_JSON_MAX_SAFE_INTEGER) return v;
     return std::to_string(v);
 }
 
