@@ -232,3 +232,51 @@ def draw_skinpack_panel(obj):
     check(panel.SKINPACK_PT_skin.poll(context), "panel does not poll for %s" % obj.name)
     panel.SKINPACK_PT_skin.draw(fake, context)
     return texts
+
+
+def rigged_grid(name, bone_count, influences, subdivisions=0):
+    """A grid skinned to a chain of bone_count bones; vertex i has `influences` distinct bones
+    with distinct weights (the strongest first), so the kept four are unambiguous."""
+    bpy.ops.object.armature_add(enter_editmode=True)
+    armature = bpy.context.active_object
+    armature.name = name + "_Rig"
+    bones = armature.data.edit_bones
+    bones[0].name = "B0"
+    for index in range(1, bone_count):
+        bone = bones.new("B%d" % index)
+        bone.head = (0, 0, index * 0.2)
+        bone.tail = (0, 0, index * 0.2 + 0.2)
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=12, size=2)
+    obj = bpy.context.active_object
+    obj.name = obj.data.name = name
+    groups = [obj.vertex_groups.new(name="B%d" % index) for index in range(bone_count)]
+    rng = numpy.random.default_rng(bone_count * 100 + influences)
+    for vertex in obj.data.vertices:
+        chosen = rng.choice(bone_count, influences, replace=False)
+        weights = numpy.sort(rng.random(influences) + 0.05)[::-1]
+        weights /= weights.sum()
+        for group, weight in zip(chosen, weights):
+            groups[group].add([vertex.index], float(weight), 'REPLACE')
+    if subdivisions:
+        modifier = obj.modifiers.new("Subdivision", 'SUBSURF')
+        modifier.levels = subdivisions
+        bpy.ops.object.modifier_apply(modifier=modifier.name)
+    obj.modifiers.new("Armature", 'ARMATURE').object = armature
+    return obj
+
+
+def weight_totals(pairs):
+    """({key: sum of weights}, {key: how many}) over (key, weight) pairs with a non-zero weight."""
+    sums, counts = {}, {}
+    for key, weight in pairs:
+        if weight > 0:
+            sums[key] = sums.get(key, 0.0) + weight
+            counts[key] = counts.get(key, 0) + 1
+    return sums, counts
+
+
+def vertex_group_weights(obj):
+    """(vertex group name, weight) of every vertex's group elements."""
+    names = [g.name for g in obj.vertex_groups]
+    return ((names[e.group], e.weight) for vertex in obj.data.vertices for e in vertex.groups)

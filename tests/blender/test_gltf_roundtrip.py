@@ -223,26 +223,15 @@ def check_import(path, decoded_maps, plain):
     """Imported vertex groups hold the decoded weights: per joint name, the sum and the number of
     non-zero weights over all imported vertices equal the decoded file's."""
     joint_names = [plain.json["nodes"][j]["name"] for j in plain.json["skins"][0]["joints"]]
-    expected_sum, expected_count = {}, {}
-    for primitive_maps in decoded_maps:
-        for entry in primitive_maps:
-            for joint, weight in entry.items():
-                key = joint_names[joint] if joint < len(joint_names) else "neutral_bone"
-                expected_sum[key] = expected_sum.get(key, 0.0) + weight
-                expected_count[key] = expected_count.get(key, 0) + 1
+    expected_sum, expected_count = common.weight_totals(
+        (joint_names[joint] if joint < len(joint_names) else "neutral_bone", weight)
+        for primitive_maps in decoded_maps for entry in primitive_maps for joint, weight in entry.items())
     existing = set(bpy.data.objects)
     bpy.ops.import_scene.gltf(filepath=path)
     imported = [o for o in bpy.data.objects if o not in existing and o.type == 'MESH' and len(o.vertex_groups)]
     common.check(len(imported) == 1, "%s: %d skinned meshes imported" % (path, len(imported)))
     obj = imported[0]
-    names = [g.name for g in obj.vertex_groups]
-    got_sum, got_count = {}, {}
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            if element.weight > 0:
-                key = names[element.group]
-                got_sum[key] = got_sum.get(key, 0.0) + element.weight
-                got_count[key] = got_count.get(key, 0) + 1
+    got_sum, got_count = common.weight_totals(common.vertex_group_weights(obj))
     common.check(len(obj.data.vertices) == sum(len(m) for m in decoded_maps), "imported vertex count")
     common.check(got_count == expected_count, "%s: imported influence counts differ from the decoded file" % path)
     worst = max(abs(got_sum[k] - expected_sum[k]) for k in expected_sum)

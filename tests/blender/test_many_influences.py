@@ -15,38 +15,6 @@ import numpy as np  # noqa: E402
 EXTENSION = "SKINPACK_packed_skin"
 
 
-def rigged_grid(name, bone_count, influences, subdivisions=0):
-    """A grid skinned to a chain of bone_count bones; vertex i has `influences` distinct bones
-    with distinct weights (the strongest first), so the kept four are unambiguous."""
-    bpy.ops.object.armature_add(enter_editmode=True)
-    armature = bpy.context.active_object
-    armature.name = name + "_Rig"
-    bones = armature.data.edit_bones
-    bones[0].name = "B0"
-    for index in range(1, bone_count):
-        bone = bones.new("B%d" % index)
-        bone.head = (0, 0, index * 0.2)
-        bone.tail = (0, 0, index * 0.2 + 0.2)
-    bpy.ops.object.mode_set(mode='OBJECT')
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=12, size=2)
-    obj = bpy.context.active_object
-    obj.name = obj.data.name = name
-    groups = [obj.vertex_groups.new(name="B%d" % index) for index in range(bone_count)]
-    rng = np.random.default_rng(bone_count * 100 + influences)
-    for vertex in obj.data.vertices:
-        chosen = rng.choice(bone_count, influences, replace=False)
-        weights = np.sort(rng.random(influences) + 0.05)[::-1]
-        weights /= weights.sum()
-        for group, weight in zip(chosen, weights):
-            groups[group].add([vertex.index], float(weight), 'REPLACE')
-    if subdivisions:
-        modifier = obj.modifiers.new("Subdivision", 'SUBSURF')
-        modifier.levels = subdivisions
-        bpy.ops.object.modifier_apply(modifier=modifier.name)
-    obj.modifiers.new("Armature", 'ARMATURE').object = armature
-    return obj
-
-
 def most_influences(obj):
     deform = {g.index for g in obj.vertex_groups}
     return max(sum(1 for e in v.groups if e.group in deform and e.weight > 0) for v in obj.data.vertices)
@@ -117,10 +85,10 @@ def main():
     common.install_addon(args.zip)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     common.install_addon(args.zip)
-    subdivided = rigged_grid("Subdivided6", 10, 6, subdivisions=1)
+    subdivided = common.rigged_grid("Subdivided6", 10, 6, subdivisions=1)
     common.check(most_influences(subdivided) > 8, "subdividing did not produce more than 8 influences")
-    nine = rigged_grid("Nine", 16, 9)
-    twelve = rigged_grid("Twelve", 300, 12)
+    nine = common.rigged_grid("Nine", 16, 9)
+    twelve = common.rigged_grid("Twelve", 300, 12)
     for obj in (subdivided, nine, twelve):
         check_compress(obj)
     for obj in (nine, twelve):

@@ -12,9 +12,7 @@ message and no output file, or write a file that the Khronos validator passes, w
 extension, whose decoded joints are all below the joint count of the skin and distinct wherever
 weighted.
 
-Not registered in ctest yet: the CLI does not call sp_validate_packed (issue 10 wires it), and
-until then this script reports the reader holes it finds (today: a `vertices` accessor shorter
-than the primitive is decoded and written).
+In ctest as cli_mutate_files (tests/cli/CMakeLists.txt: Fox and skinned_cylinder).
 """
 import copy
 import json

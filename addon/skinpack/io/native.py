@@ -73,9 +73,11 @@ def _build_structs():
 
 MIRRORED_STRUCTS = _build_structs()
 (PrepareStats, Codec, ErrorStats, CompressOptions, CompressedSkin, MeshletOptions, Meshlet, MeshletSizes,
- MeshletBuffers, MeshletStats) = (MIRRORED_STRUCTS[name] for name in (
-    "sp_prepare_stats", "sp_codec", "sp_error_stats", "sp_compress_options", "sp_compressed_skin",
-    "sp_meshlet_options", "sp_meshlet", "sp_meshlet_sizes", "sp_meshlet_buffers", "sp_meshlet_stats"))
+ MeshletBuffers, MeshletStats, PackedParams, PackedMeshlets, PackedPrimitive, Validation) = (
+    MIRRORED_STRUCTS[name] for name in (
+        "sp_prepare_stats", "sp_codec", "sp_error_stats", "sp_compress_options", "sp_compressed_skin",
+        "sp_meshlet_options", "sp_meshlet", "sp_meshlet_sizes", "sp_meshlet_buffers", "sp_meshlet_stats",
+        "sp_packed_params", "sp_packed_meshlets", "sp_packed_primitive", "sp_validation"))
 
 
 class SkinpackError(Exception):
@@ -119,6 +121,18 @@ def _declare(lib):
     lib.sp_codec_from_bits.argtypes = [ctypes.c_int, ctypes.c_uint32, ctypes.c_uint32, P(Codec)]
     lib.sp_method_name.restype = ctypes.c_char_p
     lib.sp_method_name.argtypes = [ctypes.c_int]
+    lib.sp_method_from_name.restype = ctypes.c_int
+    lib.sp_method_from_name.argtypes = [ctypes.c_char_p]
+    lib.sp_codec_from_max_error.restype = ctypes.c_int
+    lib.sp_codec_from_max_error.argtypes = [ctypes.c_int, ctypes.c_uint32, ctypes.c_double, P(Codec)]
+    lib.sp_parse_decimal.restype = ctypes.c_int
+    lib.sp_parse_decimal.argtypes = [ctypes.c_char_p, ctypes.c_size_t, P(ctypes.c_uint64)]
+    lib.sp_packed_params_equal.restype = ctypes.c_int
+    lib.sp_packed_params_equal.argtypes = [P(PackedParams), P(PackedParams)]
+    lib.sp_validate_packed.restype = ctypes.c_int
+    lib.sp_validate_packed.argtypes = [P(PackedPrimitive), P(ctypes.c_uint16), P(ctypes.c_float), P(Validation)]
+    lib.sp_format_validation.restype = ctypes.c_size_t
+    lib.sp_format_validation.argtypes = [P(Validation), ctypes.c_char_p, ctypes.c_size_t]
     lib.sp_prepare_influences.restype = ctypes.c_int
     lib.sp_prepare_influences.argtypes = [
         P(ctypes.c_uint16), P(ctypes.c_float), ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t,
@@ -312,6 +326,137 @@ def codec_from_params(method, influences, n, axis_samples=None):
     if code != SP_OK:
         raise SkinpackError("invalid codec parameters (%s): %s" % (method, result_string(code)), code)
     return codec
+
+
+def codec_from_max_error(method, influences, max_error):
+    """sp_codec_from_max_error: the codec the library's max-error search picks for this K."""
+    codec = Codec()
+    code = _require().sp_codec_from_max_error(METHODS.index(method), influences, max_error, ctypes.byref(codec))
+    if code != SP_OK:
+        raise SkinpackError("no %s codec for K = %d within max error %g: %s"
+                            % (method, influences, max_error, result_string(code)), code)
+    return codec
+
+
+def json_integer(value, name, strings=False, bits=64):
+    """A JSON integer property as an unsigned integer of `bits` bits, range-checked on the full
+    value before it is narrowed (spec: Large integers). strings: the property may hold a value
+    above 2^53 as a decimal string, which the library parses (sp_parse_decimal)."""
+    lib = _require()
+    parsed = ctypes.c_uint64(0)
+    if isinstance(value, str) and strings:
+        text = value.encode("ascii", "replace")
+        if lib.sp_parse_decimal(text, len(text), ctypes.byref(parsed)) != SP_OK:
+            raise SkinpackError("%s: %r is not a decimal string of an integer above 2^53" % (name, value))
+        return parsed.value
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SkinpackError("%s: %r is not an integer" % (name, value))
+    if value < 0 or value.bit_length() > bits:
+        raise SkinpackError("%s: %d is outside 0..2^%d - 1" % (name, value, bits))
+    text = str(value).encode("ascii")
+    if lib.sp_parse_decimal(text, len(text), ctypes.byref(parsed)) == SP_OK:  # the library's 2^53 bound
+        raise SkinpackError("%s: %d is above 2^53 and must be written as a string" % (name, value))
+    return value
+
+
+def packed_params(extension):
+    """sp_packed_params of a SKINPACK_packed_skin JSON object (a dict as json.loads returns it).
+    Only the JSON layer is checked here (types, 64-bit range); the rules are sp_validate_packed's."""
+    params = PackedParams()
+    method = extension.get("method")
+    params.method = _require().sp_method_from_name(method.encode("utf-8")) if isinstance(method, str) \
+        else len(METHODS)
+    for field, name in (("influences", "influences"), ("joint_count", "jointCount"),
+                        ("weight_bits", "weightBits"), ("tuple_bits", "tupleBits")):
+        if name not in extension:
+            raise SkinpackError("%s is missing" % name)
+        setattr(params, field, json_integer(extension[name], name, strings=False))
+    params.n = json_integer(extension.get("n"), "n", strings=True)
+    samples = extension.get("axisSamples", [])
+    if not isinstance(samples, list) or len(samples) > len(params.axis_samples):
+        raise SkinpackError("axisSamples: %r is not a list of at most %d integers"
+                            % (samples, len(params.axis_samples)))
+    for axis, value in enumerate(samples):
+        params.axis_samples[axis] = json_integer(value, "axisSamples[%d]" % axis, strings=True)
+    params.axis_sample_count = len(samples)
+    if "maxError" in extension:
+        max_error = extension["maxError"]
+        if isinstance(max_error, bool) or not isinstance(max_error, (int, float)):
+            raise SkinpackError("maxError: %r is not a number" % (max_error,))
+        params.has_max_error, params.max_error = 1, float(max_error)
+    return params
+
+
+def params_equal(a, b):
+    """sp_packed_params_equal: primitives sharing a "vertices" accessor must declare the same."""
+    return bool(_require().sp_packed_params_equal(ctypes.byref(a), ctypes.byref(b)))
+
+
+# sp_packed_meshlets array fields: (struct field, count field or None, numpy type, ctype).
+_MESHLET_ARRAYS = (("offsets", None, np.uint32, ctypes.c_uint32), ("counts", None, np.uint32, ctypes.c_uint32),
+                   ("vertices", "vertex_entries", np.uint32, ctypes.c_uint32),
+                   ("vertex_tuples", "vertex_entries", np.uint8, ctypes.c_uint8),
+                   ("triangles", "triangle_bytes", np.uint8, ctypes.c_uint8),
+                   ("joints", "joint_entries", np.uint16, ctypes.c_uint16),
+                   ("tuples", None, np.uint8, ctypes.c_uint8))
+
+
+def _packed_meshlets(meshlets, influences, keep):
+    """sp_packed_meshlets from a dict of arrays named as its fields (offsets and counts (M, 4),
+    tuples (T, K)) and the declared limits; keep collects the arrays that must outlive the call."""
+    packed = PackedMeshlets()
+    for field, count_field, dtype, ctype in _MESHLET_ARRAYS:
+        array = np.ascontiguousarray(meshlets[field], dtype=dtype).reshape(-1)
+        keep.append(array)
+        setattr(packed, field, _pointer(array, ctype))
+        if count_field is not None:
+            setattr(packed, count_field, len(array))
+    packed.meshlet_count = np.asarray(meshlets["offsets"]).size // 4
+    packed.tuple_count = np.asarray(meshlets["tuples"]).size // max(influences, 1)
+    for limit in ("max_vertices", "max_triangles", "max_joints"):
+        setattr(packed, limit, int(meshlets.get(limit, 0)))
+    return packed
+
+
+def validate_packed(params, words, words_per_vertex, primitive_vertex_count, lut, lut_component_bytes,
+                    skin_joint_count, meshlets=None):
+    """sp_validate_packed on one stored primitive, decoding it: returns (joints (V, K) uint16,
+    weights (V, K) float32, sp_codec). words: the "vertices" accessor's u32 words (V * words_per_vertex);
+    lut: the "tupleTable" accessor as (entries, components); skin_joint_count: joints of the
+    smallest skin of the nodes that use the mesh (0 if none); meshlets: see _packed_meshlets.
+    Raises SkinpackError with sp_format_validation's message."""
+    lib = _require()
+    words = np.ascontiguousarray(words, dtype=np.uint32).reshape(-1)
+    lut = np.ascontiguousarray(lut, dtype=np.uint16)
+    lut = lut.reshape(len(lut), -1) if lut.size else lut.reshape(0, 1)
+    vertex_count = len(words) // max(words_per_vertex, 1)
+    keep = []
+    primitive = PackedPrimitive()
+    primitive.params = params
+    primitive.words = _pointer(words, ctypes.c_uint32)
+    primitive.vertex_count = vertex_count
+    primitive.words_per_vertex = words_per_vertex
+    primitive.primitive_vertex_count = primitive_vertex_count
+    primitive.lut = _pointer(lut, ctypes.c_uint16)
+    primitive.lut_size, primitive.lut_components = lut.shape
+    primitive.lut_component_bytes = lut_component_bytes
+    primitive.skin_joint_count = skin_joint_count
+    if meshlets is not None:
+        keep.append(_packed_meshlets(meshlets, params.influences, keep))
+        primitive.meshlets = ctypes.pointer(keep[-1])
+    K = min(int(params.influences), SP_MAX_INFLUENCES)  # the library checks K first, then writes V * K
+    joints = np.zeros((vertex_count, max(K, 1)), dtype=np.uint16)
+    weights = np.zeros((vertex_count, max(K, 1)), dtype=np.float32)
+    report = Validation()
+    code = lib.sp_validate_packed(ctypes.byref(primitive), _pointer(joints, ctypes.c_uint16),
+                                  _pointer(weights, ctypes.c_float), ctypes.byref(report))
+    if code != SP_OK:
+        size = lib.sp_format_validation(ctypes.byref(report), None, 0) + 1
+        message = ctypes.create_string_buffer(size)
+        lib.sp_format_validation(ctypes.byref(report), message, size)
+        raise SkinpackError(message.value.decode("utf-8", "replace"), code,
+                            int(report.index) if report.field == _abi.ENUMS["sp_field"]["SP_FIELD_VERTICES"] else None)
+    return joints[:, :K], weights[:, :K], report.codec
 
 
 def decompress(method, influences, n, axis_samples, words, vertex_count, tuple_bits, lut, joint_count):
