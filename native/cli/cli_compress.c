@@ -243,41 +243,6 @@ static int parse_args(int argc, char** argv, compress_args* args) {
     return 0;
 }
 
-/* --max-error: the smallest weight-code width whose codec bound meets the target, for the K the
- * library will use (min(max_influences, largest influence count)). */
-static int weight_bits_for_error(const compress_args* args, const uint16_t* joints, const float* weights,
-                                 size_t vertex_count, size_t stride, size_t joint_count, uint32_t* bits, char* err,
-                                 size_t err_size) {
-    uint32_t k = args->options.max_influences;
-    uint16_t* pj = malloc(vertex_count * k * sizeof(uint16_t));
-    float* pw = malloc(vertex_count * k * sizeof(float));
-    sp_prepare_stats stats;
-    memset(&stats, 0, sizeof(stats));
-    sp_result r = pj && pw ? sp_prepare_influences(joints, weights, vertex_count, stride, joint_count, k,
-                                                   args->options.sum_tolerance, pj, pw, NULL, &stats)
-                           : SP_ERR_INVALID_ARGUMENT;
-    free(pj);
-    free(pw);
-    if (r != SP_OK) {
-        snprintf(err, err_size, "vertex %zu: %s", stats.error_vertex, sp_result_string(r));
-        return -1;
-    }
-    uint32_t largest = 1;
-    for (uint32_t c = 1; c <= SP_MAX_INPUT_INFLUENCES; ++c)
-        if (stats.influence_histogram[c]) largest = c;
-    uint32_t k_used = largest < k ? largest : k;
-    for (uint32_t b = 0; b <= SP_MAX_WEIGHT_BITS; ++b) {
-        sp_codec codec;
-        if (sp_codec_from_bits(args->options.method, k_used, b, &codec) == SP_OK && codec.max_error <= args->max_error) {
-            *bits = b;
-            return 0;
-        }
-    }
-    snprintf(err, err_size, "no %s configuration reaches a max error of %g", sp_method_name(args->options.method),
-             args->max_error);
-    return -1;
-}
-
 /*
  * --meshlets: sp_build_meshlets on the primitive's triangles with the weights and joints a
  * decoder will see (the packed data decoded again), stored as the extension's "meshlets".
@@ -431,9 +396,10 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
         if (joint_count == 0) joint_count = 1;
     }
     sp_compress_options options = args->options;
-    if (args->max_error > 0 &&
-        weight_bits_for_error(args, joints, weights, vc, stride, joint_count, &options.weight_bits, err, err_size))
-        goto done;
+    if (args->max_error > 0) { /* the library's one search, for the K it will use (also K = 1) */
+        options.vertex_bits = options.weight_bits = 0;
+        options.max_error = args->max_error;
+    }
 
     sp_result r = sp_compress_skin(joints, weights, vc, stride, joint_count, &options, words, lut, NULL, NULL,
                                    &p->skin, scratch, scratch_size);

@@ -7,6 +7,7 @@
 // when decompress takes it away again). Every other member and every other byte is written as
 // it was read.
 #include "gltf_doc.hpp"
+#include "skinpack.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,8 +1,9 @@
 """Writes a small valid skinned .glb whose vertices have 1 to 8 influences (JOINTS_0/WEIGHTS_0
 and JOINTS_1/WEIGHTS_1), to test the stride-8 path and pruning to K = 4, with two primitives
-that share all their accessors.
+that share all their accessors. With MAX (1..8) vertices have 1 to MAX influences: MAX 1
+makes a rigid, single-influence mesh (K = 1).
 
-    python3 make_eight_influences.py OUT.glb
+    python3 make_eight_influences.py OUT.glb [MAX]
 """
 import os
 import struct
@@ -14,9 +15,9 @@ import gltf_read  # noqa: E402
 JOINTS = 8
 
 
-def vertex_influences(v):
-    """Deterministic, distinct joints with strictly decreasing weights; 1..8 influences."""
-    count = 1 + v % 8
+def vertex_influences(v, most):
+    """Deterministic, distinct joints with strictly decreasing weights; 1..most influences."""
+    count = 1 + v % most
     joints = [(v * 3 + i * 5) % JOINTS for i in range(count)]
     joints = list(dict.fromkeys(joints))  # distinct, order kept
     raw = [1.0 / (i + 1.5) ** 1.3 for i in range(len(joints))]
@@ -28,13 +29,14 @@ def vertex_influences(v):
 
 def main():
     out = sys.argv[1]
+    most = int(sys.argv[2]) if len(sys.argv) > 2 else 8
     columns, rows = 4, 6
     positions, joints0, joints1, weights0, weights1 = [], [], [], [], []
     for y in range(rows):
         for x in range(columns):
             v = y * columns + x
             positions.append((float(x), float(y), 0.0))
-            j, w = vertex_influences(v)
+            j, w = vertex_influences(v, most)
             j += [0] * (8 - len(j))
             w += [0.0] * (8 - len(w))
             joints0.append(j[:4])
