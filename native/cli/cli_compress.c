@@ -105,17 +105,17 @@ static int check_budget(const compress_args* args) {
     weight_bits_range(o->method, o->max_influences, &lo, &hi);
     const char* name = sp_method_name(o->method);
     if (lo > hi) {
-        fprintf(stderr, "skinpack compress: --method %s is not defined for %u influences (--max-influences)\n", name,
+        fprintf(stderr, "Error: --method %s is not defined for %u influences (--max-influences)\n", name,
                 o->max_influences);
         return -1;
     }
     if (args->weight_bits_given && (o->weight_bits == 0 || o->weight_bits < lo || o->weight_bits > hi)) {
-        fprintf(stderr, "skinpack compress: --weight-bits %u: method %s with %u influences takes %u..%u bits\n",
+        fprintf(stderr, "Error: --weight-bits %u: method %s with %u influences takes %u..%u bits\n",
                 o->weight_bits, name, o->max_influences, lo ? lo : 1, hi);
         return -1;
     }
     if (o->vertex_bits && o->vertex_bits < lo) {
-        fprintf(stderr, "skinpack compress: --vertex-bits %u: method %s with %u influences needs at least %u bits for "
+        fprintf(stderr, "Error: --vertex-bits %u: method %s with %u influences needs at least %u bits for "
                 "the weights, plus the tuple index\n", o->vertex_bits, name, o->max_influences, lo);
         return -1;
     }
@@ -132,21 +132,21 @@ static int parse_budget(const char* a, const char* value, compress_args* args) {
     if (strcmp(a, "--vertex-bits") == 0) {
         o->weight_bits = 0;
         if (parse_uint(value, SP_MAX_VERTEX_BITS, &o->vertex_bits) || !o->vertex_bits) {
-            fprintf(stderr, "skinpack compress: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
+            fprintf(stderr, "Error: --vertex-bits must be 1..%d\n", SP_MAX_VERTEX_BITS);
             return -1;
         }
     } else if (strcmp(a, "--weight-bits") == 0) {
         o->vertex_bits = 0;
         args->weight_bits_given = 1;
         if (parse_uint(value, SP_MAX_WEIGHT_BITS, &o->weight_bits)) {
-            fprintf(stderr, "skinpack compress: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
+            fprintf(stderr, "Error: --weight-bits must be 0..%d\n", SP_MAX_WEIGHT_BITS);
             return -1;
         }
     } else {
         char* end = NULL;
         args->max_error = strtod(value, &end);
         if (*end || !(args->max_error > 0 && args->max_error < 1)) {
-            fprintf(stderr, "skinpack compress: --max-error must be a number in (0, 1)\n");
+            fprintf(stderr, "Error: --max-error must be a number in (0, 1)\n");
             return -1;
         }
         o->vertex_bits = 0;
@@ -165,7 +165,7 @@ static int parse_meshlet_limit(const char* a, const char* value, compress_args* 
     if (!field || !value) return 0;
     if (!args->meshlet_limit) args->meshlet_limit = a;
     if (parse_uint(value, UINT32_MAX, field) || sp_check_meshlet_options(o) != SP_OK) {
-        fprintf(stderr, "skinpack compress: %s %s: vertices must be 3..%d, triangles 1..%d, joints 1..%d\n", a, value,
+        fprintf(stderr, "Error: %s %s: vertices must be 3..%d, triangles 1..%d, joints 1..%d\n", a, value,
                 SP_MESHLET_MAX_VERTICES, SP_MESHLET_MAX_TRIANGLES, SP_MESHLET_MAX_JOINTS);
         return -1;
     }
@@ -190,7 +190,7 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         } else if (strcmp(a, "--method") == 0 && value) {
             args->options.method = sp_method_from_name(value);
             if (args->options.method == SP_METHOD_COUNT) {
-                fprintf(stderr, "skinpack compress: --method: unknown method '%s' (", value);
+                fprintf(stderr, "Error: --method: unknown method '%s' (", value);
                 for (int m = 0; m < SP_METHOD_COUNT; ++m) fprintf(stderr, "%s%s", m ? ", " : "", sp_method_name((sp_method)m));
                 fprintf(stderr, ")\n");
                 return -1;
@@ -203,7 +203,7 @@ static int parse_args(int argc, char** argv, compress_args* args) {
         } else if (strcmp(a, "--max-influences") == 0 && value) {
             if (parse_uint(value, SP_MAX_INFLUENCES, &args->options.max_influences) ||
                 !args->options.max_influences) {
-                fprintf(stderr, "skinpack compress: --max-influences must be 1..%d\n", SP_MAX_INFLUENCES);
+                fprintf(stderr, "Error: --max-influences must be 1..%d\n", SP_MAX_INFLUENCES);
                 return -1;
             }
             ++i;
@@ -221,18 +221,18 @@ static int parse_args(int argc, char** argv, compress_args* args) {
             compress_usage(stdout);
             exit(0);
         } else if (a[0] == '-' || args->input) {
-            fprintf(stderr, "skinpack compress: unexpected argument '%s'\n", a);
+            fprintf(stderr, "Error: unexpected argument '%s'\n", a);
             return -1;
         } else {
             args->input = a;
         }
     }
     if (args->meshlet_limit && !args->meshlets) {
-        fprintf(stderr, "skinpack compress: %s needs --meshlets\n", args->meshlet_limit);
+        fprintf(stderr, "Error: %s needs --meshlets\n", args->meshlet_limit);
         return -1;
     }
     if (budgets > 1) {
-        fprintf(stderr, "skinpack compress: give at most one of --vertex-bits, --weight-bits, --max-error\n");
+        fprintf(stderr, "Error: give at most one of --vertex-bits, --weight-bits, --max-error\n");
         return -1;
     }
     if (check_budget(args)) return -1;
@@ -558,14 +558,14 @@ static long find_skinned(const gltf_doc* doc, const compress_args* args, compres
                 skinned = -1;
             }
             if (skinned < 0) {
-                fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, m, pi, err);
+                fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", args->input, m, pi, err);
                 free(prims);
                 return -1;
             }
             if (!skinned) continue;
             compressed_primitive* grown = cli_grow(prims, &capacity, count, sizeof(*prims));
             if (!grown) {
-                fprintf(stderr, "skinpack compress: out of memory\n");
+                fprintf(stderr, "Error: out of memory\n");
                 free(prims);
                 return -1;
             }
@@ -600,7 +600,7 @@ static int compress_all(gltf_doc* doc, const compress_args* args, compressed_pri
             p->output_bits_per_vertex = first->output_bits_per_vertex;
             p->meshlet_stats = first->meshlet_stats;
         } else if (compress_primitive(doc, args, p, err, sizeof(err))) {
-            fprintf(stderr, "skinpack compress: %s: mesh %zu primitive %zu: %s\n", args->input, p->mesh, p->primitive,
+            fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", args->input, p->mesh, p->primitive,
                     err);
             return -1;
         }
@@ -615,7 +615,7 @@ int skinpack_cmd_compress(int argc, char** argv) {
     char err[CLI_ERR_SIZE];
     gltf_doc* doc = gltf_load_file(args.input, err, sizeof(err));
     if (!doc) {
-        fprintf(stderr, "skinpack compress: %s: %s\n", args.input, err);
+        fprintf(stderr, "Error: %s: %s\n", args.input, err);
         return 1;
     }
     compressed_primitive* prims = NULL;
@@ -627,10 +627,10 @@ int skinpack_cmd_compress(int argc, char** argv) {
         size_t copied = 0;
         if (gltf_write_unchanged(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &copied,
                                  err, sizeof(err))) {
-            fprintf(stderr, "skinpack compress: %s\n", err);
+            fprintf(stderr, "Error: %s\n", err);
             goto done;
         }
-        fprintf(stderr, "skinpack compress: %s: no skinned primitives, nothing to compress; written unchanged to %s\n",
+        fprintf(stderr, "Warning: %s: no skinned primitives, nothing to compress; written unchanged to %s\n",
                 args.input, args.output);
         rc = 0;
         goto done;
@@ -640,7 +640,7 @@ int skinpack_cmd_compress(int argc, char** argv) {
     size_t freed = 0;
     for (size_t i = 0; i < count && args.compact; ++i) freed += make_compact(doc, &prims[i]);
     if (args.compact && freed == 0)
-        fprintf(stderr, "skinpack compress: %s: warning: the old JOINTS_n/WEIGHTS_n bytes stay in the file (they are "
+        fprintf(stderr, "Warning: %s: the old JOINTS_n/WEIGHTS_n bytes stay in the file (they are "
                 "in an external buffer, shared, or the file uses an extension whose references skinpack does not "
                 "know); the file is correct but not smaller\n", args.input);
     if (compress_all(doc, &args, prims, count)) goto done;
@@ -648,7 +648,7 @@ int skinpack_cmd_compress(int argc, char** argv) {
     size_t output_bytes = 0;
     if (gltf_write_file(doc, args.output, cli_output_is_binary(args.output, gltf_is_binary(doc)), &output_bytes, err,
                         sizeof(err))) {
-        fprintf(stderr, "skinpack compress: %s\n", err);
+        fprintf(stderr, "Error: %s\n", err);
         goto done;
     }
     if (args.json)

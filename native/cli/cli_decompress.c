@@ -31,7 +31,7 @@ static int parse_settings(int argc, char** argv, decompress_settings* settings) 
         } else if (argv[i][0] != '-' && !settings->input) {
             settings->input = argv[i];
         } else {
-            fprintf(stderr, "skinpack decompress: unexpected argument '%s'\n", argv[i]);
+            fprintf(stderr, "Error: unexpected argument '%s'\n", argv[i]);
             return -1;
         }
     }
@@ -98,7 +98,7 @@ static long decode_all(gltf_doc* doc, const char* input, decoded_primitive** out
             if (has == 0 && skinned > 0 && at.placeholder)
                 snprintf(err, sizeof(err), "JOINTS_0/WEIGHTS_0 have no data and there is no " GLTF_EXTENSION_NAME);
             if (has < 0 || (has == 0 && skinned > 0 && at.placeholder)) {
-                fprintf(stderr, "skinpack decompress: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
+                fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto fail;
             }
             if (has == 0) continue;
@@ -118,7 +118,7 @@ static long decode_all(gltf_doc* doc, const char* input, decoded_primitive** out
                     list[i].packed.tuple_table == packed.tuple_table)
                     d->shared_with = (long)i;
             if (d->shared_with < 0 && cli_decode_packed(doc, m, p, &packed, &d->skin, err, sizeof(err))) {
-                fprintf(stderr, "skinpack decompress: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
+                fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto fail;
             }
             ++count;
@@ -160,7 +160,7 @@ int skinpack_cmd_decompress(int argc, char** argv) {
     char err[CLI_ERR_SIZE];
     gltf_doc* doc = gltf_load_file(settings.input, err, sizeof(err));
     if (!doc) {
-        fprintf(stderr, "skinpack decompress: %s: %s\n", settings.input, err);
+        fprintf(stderr, "Error: %s: %s\n", settings.input, err);
         return 1;
     }
     int rc = 1, binary = cli_output_is_binary(settings.output, gltf_is_binary(doc));
@@ -170,7 +170,7 @@ int skinpack_cmd_decompress(int argc, char** argv) {
     if (count < 0) goto done;
     if (count == 0) {
         if (gltf_write_unchanged(doc, settings.output, binary, &bytes, err, sizeof(err))) goto write_error;
-        fprintf(stderr, "skinpack decompress: %s: no " GLTF_EXTENSION_NAME " primitives; written unchanged to %s\n",
+        fprintf(stderr, "Warning: %s: no " GLTF_EXTENSION_NAME " primitives; written unchanged to %s\n",
                 settings.input, settings.output);
         rc = 0;
         goto done;
@@ -194,7 +194,7 @@ int skinpack_cmd_decompress(int argc, char** argv) {
     rc = 0;
     goto done;
 write_error:
-    fprintf(stderr, "skinpack decompress: %s\n", err);
+    fprintf(stderr, "Error: %s\n", err);
 done:
     for (long i = 0; i < count; ++i) cli_decoded_skin_free(&list[i].skin);
     free(list);

@@ -263,7 +263,7 @@ int skinpack_cmd_info(int argc, char** argv) {
         else if (argv[i][0] != '-' && !input)
             input = argv[i];
         else {
-            fprintf(stderr, "skinpack info: unexpected argument '%s'\n", argv[i]);
+            fprintf(stderr, "Error: unexpected argument '%s'\n", argv[i]);
             return 2;
         }
     }
@@ -274,7 +274,7 @@ int skinpack_cmd_info(int argc, char** argv) {
     char err[CLI_ERR_SIZE];
     gltf_doc* doc = gltf_load_file(input, err, sizeof(err));
     if (!doc) {
-        fprintf(stderr, "skinpack info: %s: %s\n", input, err);
+        fprintf(stderr, "Error: %s: %s\n", input, err);
         return 1;
     }
     primitive_info* infos = NULL;
@@ -301,7 +301,7 @@ int skinpack_cmd_info(int argc, char** argv) {
                 ok = skinned > 0 && info_standard(doc, &at, &info, err, sizeof(err)) == 0;
             }
             if (!ok) {
-                fprintf(stderr, "skinpack info: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
+                fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
                 goto done;
             }
             primitive_info* grown = cli_grow(infos, &capacity, count, sizeof(*infos));

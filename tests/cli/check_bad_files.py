@@ -4,7 +4,7 @@
 
 From ASSET (a skinned .glb with float weights, e.g. Fox.glb) it makes one broken file per case,
 standard and packed, and runs the commands that read it. A case passes when the command exits
-with 1 (a crash is a signal or another code), prints "skinpack ...: <reason>" on stderr where
+with 1 (a crash is a signal or another code), prints "Error: <file>: <reason>" on stderr where
 reason contains the expected words, and leaves neither OUT nor a temporary file behind.
 """
 import argparse
@@ -194,7 +194,7 @@ def expect_failure(cmd, words, out, work):
     problems = []
     if result.returncode != 1:
         problems.append("exit status %d (want 1)" % result.returncode)
-    if not result.stderr.startswith("skinpack") or words.lower() not in result.stderr.lower():
+    if not result.stderr.startswith("Error: ") or words.lower() not in result.stderr.lower():
         problems.append("stderr %r lacks %r" % (result.stderr.strip(), words))
     if out and os.path.exists(out):
         problems.append("output %s was written" % out)
