@@ -16,7 +16,7 @@
 // so a loader without the extension refuses them; the reader gives such views zero bytes.
 
 import { Extension, ExtensionProperty, PropertyType } from '@gltf-transform/core';
-import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from '../src/decode.js';
+import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, jointBytes, SKINPACK_EXTENSION } from '../src/decode.js';
 
 export const WORDS_ATTRIBUTE = '_SKINPACK_WORDS';
 const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'weightBits', 'tupleBits', 'maxError'];
@@ -170,8 +170,8 @@ function addPlaceholders(json, primitiveDef, count, jointCount, placeholders) {
     placeholders.byteLength += byteLength;
     return json.accessors.push({ bufferView: view, componentType, count, type: 'VEC4' }) - 1;
   };
-  const joints16 = jointCount > 256;
-  primitiveDef.attributes.JOINTS_0 = add(joints16 ? UNSIGNED_SHORT : UNSIGNED_BYTE, joints16 ? 2 : 1);
+  const jointSize = jointBytes(jointCount);
+  primitiveDef.attributes.JOINTS_0 = add(jointSize === 2 ? UNSIGNED_SHORT : UNSIGNED_BYTE, jointSize);
   primitiveDef.attributes.WEIGHTS_0 = add(FLOAT, 4);
 }
 

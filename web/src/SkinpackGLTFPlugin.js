@@ -12,7 +12,7 @@ import {
   BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,
   RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
 } from 'three';
-import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, SKINPACK_EXTENSION } from './decode.js';
+import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, jointBytes, SKINPACK_EXTENSION } from './decode.js';
 import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
@@ -99,7 +99,7 @@ export class SkinpackGLTFPlugin {
     const wordType = codec.wordsPerVertex === 1 ? 'SCALAR' : 'VEC2';
     if (wordsDef.componentType !== COMPONENT_UNSIGNED_INT || wordsDef.type !== wordType)
       throw new Error(`"vertices" accessor ${ext.vertices} must be UNSIGNED_INT ${wordType} for ${codec.tupleBits + codec.weightBits} bits`);
-    const tableComponent = codec.jointCount <= 256 ? COMPONENT_UNSIGNED_BYTE : COMPONENT_UNSIGNED_SHORT;
+    const tableComponent = jointBytes(codec.jointCount) === 1 ? COMPONENT_UNSIGNED_BYTE : COMPONENT_UNSIGNED_SHORT;
     if (tableDef.componentType !== tableComponent || tableDef.type !== TABLE_TYPES[codec.influences - 1])
       throw new Error(`"tupleTable" accessor ${ext.tupleTable} must be ${tableComponent === COMPONENT_UNSIGNED_BYTE ? 'UNSIGNED_BYTE' : 'UNSIGNED_SHORT'} ${TABLE_TYPES[codec.influences - 1]}`);
     for (const [field, accessor] of [['vertices', wordsDef], ['tupleTable', tableDef]]) this._checkAccessor(field, ext[field], accessor);
@@ -158,7 +158,7 @@ export class SkinpackGLTFPlugin {
       skinIndex: geometry.getAttribute('skinIndex'), skinWeight: geometry.getAttribute('skinWeight') } });
     if (refusal) {
       if (this.decode === 'gpu') console.warn(`SkinpackGLTFPlugin: ${where}: CPU decode: ${refusal}`);
-      const joints = codec.jointCount <= 256 ? Uint8Array.from(decoded.joints) : decoded.joints; // as glTF stores them
+      const joints = jointBytes(codec.jointCount) === 1 ? Uint8Array.from(decoded.joints) : decoded.joints; // as glTF stores them
       geometry.setAttribute('skinIndex', new BufferAttribute(joints, 4));
       geometry.setAttribute('skinWeight', new BufferAttribute(decoded.weights, 4));
       info.gpuSkinBytes = joints.byteLength + decoded.weights.byteLength;

@@ -84,6 +84,12 @@ export function compactLayout(json, primitiveDef) {
   return isFallbackBuffer(buffer) ? 'fallback-buffer' : null;
 }
 
+/** Bytes of a joint index in JOINTS_n and in the tuple table: 1 up to 256 joints, else 2 (the
+ * library's sp_joint_bytes rule; jointCount already checked by codecFromExtension). */
+export function jointBytes(jointCount) {
+  return jointCount <= 256 ? 1 : 2;
+}
+
 /** A buffer without data that only compact primitives' JOINTS_0/WEIGHTS_0 point into. */
 export function isFallbackBuffer(buffer) {
   const mark = buffer && buffer.extensions && buffer.extensions[SKINPACK_EXTENSION];
