@@ -7,6 +7,7 @@ the same fields back. Field names and the LUT's component width are defined once
 import numpy as np
 
 from . import _abi  # generated from skinpack.h (addon/generate_abi.py)
+from . import native
 
 EXTENSION_NAME = "SKINPACK_packed_skin"
 
@@ -22,8 +23,8 @@ NORMALIZED_SCALE = {COMPONENT_UNSIGNED_BYTE: 255.0, COMPONENT_UNSIGNED_SHORT: 65
 
 
 def joint_component(joint_count):
-    """JOINTS_n and LUT entries: u8 up to 256 joints, else u16 (what glTF exporters write)."""
-    return COMPONENT_UNSIGNED_BYTE if joint_count <= 256 else COMPONENT_UNSIGNED_SHORT
+    """JOINTS_n and LUT entries: u8 up to 256 joints, else u16 (the library's sp_joint_bytes)."""
+    return COMPONENT_UNSIGNED_BYTE if native.joint_bytes(joint_count) == 1 else COMPONENT_UNSIGNED_SHORT
 
 
 class ArrayField:

@@ -125,6 +125,8 @@ def _declare(lib):
     lib.sp_method_from_name.argtypes = [ctypes.c_char_p]
     lib.sp_codec_from_max_error.restype = ctypes.c_int
     lib.sp_codec_from_max_error.argtypes = [ctypes.c_int, ctypes.c_uint32, ctypes.c_double, P(Codec)]
+    lib.sp_joint_bytes.restype = ctypes.c_uint32
+    lib.sp_joint_bytes.argtypes = [ctypes.c_size_t]
     lib.sp_parse_decimal.restype = ctypes.c_int
     lib.sp_parse_decimal.argtypes = [ctypes.c_char_p, ctypes.c_size_t, P(ctypes.c_uint64)]
     lib.sp_packed_params_equal.restype = ctypes.c_int
@@ -245,6 +247,12 @@ def _require():
 
 def result_string(code):
     return _require().sp_result_string(code).decode("utf-8", "replace")
+
+
+def joint_bytes(joint_count):
+    """Bytes of one JOINTS_n / tupleTable component (sp_joint_bytes): 1 up to 256 joints, 2 up
+    to SP_MAX_JOINTS, 0 outside 1..SP_MAX_JOINTS."""
+    return int(_require().sp_joint_bytes(int(joint_count)))
 
 
 def default_options():
