@@ -92,7 +92,7 @@ def _draw_stats(layout, mesh, result):
     if storage.is_stale(mesh, result):
         box.label(text="Stored result is out of date: compress again", icon='ERROR')
     grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
-    per_vertex_data = stats["tuple_bits"] + stats["weight_bits"] > 0
+    per_vertex_data = skin_services.stores_per_vertex_data(stats)
     rows = (
         ("Method", "%s, K = %d" % (stats["method"].upper(), stats["influences"])),
         ("Bits / vertex", "%.1f \u2192 %.1f" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"])

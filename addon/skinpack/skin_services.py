@@ -56,10 +56,15 @@ def compress_object(obj):
     return storage.save_result(obj.data, compressed, stats, skin, settings)
 
 
+def stores_per_vertex_data(stats):
+    """False for a skin with one joint tuple: no per-vertex bits, only the tuple table, so a
+    ratio against the table alone would mean nothing."""
+    return stats["tuple_bits"] + stats["weight_bits"] > 0
+
+
 def size_text(stats):
-    """Bits a vertex before and after; a skin with one joint tuple stores no per-vertex data,
-    and a ratio against its table alone would mean nothing."""
-    if stats["tuple_bits"] + stats["weight_bits"] == 0:
+    """Bits a vertex before and after (see stores_per_vertex_data for the one-tuple case)."""
+    if not stores_per_vertex_data(stats):
         return "%.1f -> 0 bits/vertex (one joint tuple: only the %d-entry table is stored)" % (
             stats["input_bits_per_vertex"], stats["unique_tuples"])
     return "%.1f -> %.1f bits/vertex (%.1fx)" % (stats["input_bits_per_vertex"], stats["bits_per_vertex"],
