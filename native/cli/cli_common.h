@@ -37,8 +37,8 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
                              uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
                              size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size);
 
-/* The same, reading the arrays from the document; the vertex count must be the primitive's
- * (its POSITION count). */
+/* The same, reading the arrays from the document; the packed vertex count must be the
+ * primitive's POSITION count (not checked when the primitive has no valid POSITION). */
 int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
                       cli_decoded_skin* out, char* err, size_t err_size);
 

@@ -243,6 +243,57 @@ static int parse_args(int argc, char** argv, compress_args* args) {
     return 0;
 }
 
+/* The built meshlets as the extension's "meshlets" accessors: per-meshlet offsets, counts, bounds
+ * and cones packed four to an element, then the flat arrays as sp_build_meshlets wrote them. */
+static int add_meshlet_accessors(gltf_doc* doc, gltf_packed_meshlets* ml, const sp_meshlet_buffers* out,
+                                 const sp_meshlet_stats* stats, const sp_meshlet_options* options, uint32_t k,
+                                 char* err, size_t err_size) {
+    size_t n = stats->meshlet_count;
+    uint32_t* offsets = malloc(n * 4 * sizeof(uint32_t));
+    uint16_t* counts = malloc(n * 4 * sizeof(uint16_t));
+    float* bounds = malloc(n * 4 * sizeof(float));
+    float* cones = malloc(n * 4 * sizeof(float));
+    int rc = -1;
+    if (!offsets || !counts || !bounds || !cones) {
+        snprintf(err, err_size, "out of memory");
+        goto done;
+    }
+    for (size_t m = 0; m < n; ++m) {
+        const sp_meshlet* built = &out->meshlets[m];
+        uint32_t o[4] = {built->vertex_offset, built->triangle_offset, built->joint_offset, built->tuple_offset};
+        uint16_t c[4] = {built->vertex_count, built->triangle_count, built->joint_count, built->tuple_count};
+        float b[4] = {built->center[0], built->center[1], built->center[2], built->radius};
+        float cone[4] = {built->cone_axis[0], built->cone_axis[1], built->cone_axis[2], built->cone_cutoff};
+        memcpy(offsets + 4 * m, o, sizeof(o));
+        memcpy(counts + 4 * m, c, sizeof(c));
+        memcpy(bounds + 4 * m, b, sizeof(b));
+        memcpy(cones + 4 * m, cone, sizeof(cone));
+    }
+    ml->present = 1;
+    ml->offsets = gltf_add_accessor(doc, offsets, n, GLTF_UNSIGNED_INT, 4, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->counts = gltf_add_accessor(doc, counts, n, GLTF_UNSIGNED_SHORT, 4, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->bounds = gltf_add_accessor(doc, bounds, n, GLTF_FLOAT, 4, 0, 0);
+    ml->cones = gltf_add_accessor(doc, cones, n, GLTF_FLOAT, 4, 0, 0);
+    ml->vertices = gltf_add_accessor(doc, out->vertices, stats->vertex_count, GLTF_UNSIGNED_INT, 1, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->vertex_tuples = gltf_add_accessor(doc, out->vertex_tuples, stats->vertex_count, GLTF_UNSIGNED_BYTE, 1, 0,
+                                          GLTF_ACCESSOR_BOUNDS);
+    ml->triangles = gltf_add_accessor(doc, out->triangles, stats->triangle_count * 3, GLTF_UNSIGNED_BYTE, 1, 0,
+                                      GLTF_ACCESSOR_BOUNDS);
+    ml->joints = gltf_add_accessor(doc, out->joints, stats->joint_count, GLTF_UNSIGNED_SHORT, 1, 0, GLTF_ACCESSOR_BOUNDS);
+    ml->tuples = gltf_add_accessor(doc, out->tuples, stats->tuple_count, GLTF_UNSIGNED_BYTE, (int)k, 0,
+                                   GLTF_ACCESSOR_BOUNDS);
+    ml->max_vertices = options->max_vertices;
+    ml->max_triangles = options->max_triangles;
+    ml->max_joints = options->max_joints;
+    rc = 0;
+done:
+    free(offsets);
+    free(counts);
+    free(bounds);
+    free(cones);
+    return rc;
+}
+
 /*
  * --meshlets: sp_build_meshlets on the primitive's triangles with the weights and joints a
  * decoder will see (the packed data decoded again), stored as the extension's "meshlets".
@@ -276,10 +327,6 @@ static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t
     out.tuples = malloc(sizes.tuples * k);
     out.capacity = sizes;
     void* scratch = malloc(sizes.scratch_bytes ? sizes.scratch_bytes : 1);
-    uint32_t* offsets = NULL;
-    uint16_t* counts = NULL;
-    float* bounds = NULL;
-    float* cones = NULL;
     int rc = -1;
     sp_meshlet_stats* stats = &p->meshlet_stats;
     if (!indices || !positions || !out.meshlets || !out.vertices || !out.vertex_tuples || !out.triangles ||
@@ -298,43 +345,7 @@ static int build_meshlets(gltf_doc* doc, compressed_primitive* p, const uint32_t
             snprintf(err, err_size, "meshlets: %s (triangle %zu)", sp_result_string(r), stats->error_triangle);
         goto done;
     }
-    size_t n = stats->meshlet_count;
-    offsets = malloc(n * 4 * sizeof(uint32_t));
-    counts = malloc(n * 4 * sizeof(uint16_t));
-    bounds = malloc(n * 4 * sizeof(float));
-    cones = malloc(n * 4 * sizeof(float));
-    if (!offsets || !counts || !bounds || !cones) {
-        snprintf(err, err_size, "out of memory");
-        goto done;
-    }
-    for (size_t m = 0; m < n; ++m) {
-        const sp_meshlet* ml = &out.meshlets[m];
-        uint32_t o[4] = {ml->vertex_offset, ml->triangle_offset, ml->joint_offset, ml->tuple_offset};
-        uint16_t c[4] = {ml->vertex_count, ml->triangle_count, ml->joint_count, ml->tuple_count};
-        float b[4] = {ml->center[0], ml->center[1], ml->center[2], ml->radius};
-        float cone[4] = {ml->cone_axis[0], ml->cone_axis[1], ml->cone_axis[2], ml->cone_cutoff};
-        memcpy(offsets + 4 * m, o, sizeof(o));
-        memcpy(counts + 4 * m, c, sizeof(c));
-        memcpy(bounds + 4 * m, b, sizeof(b));
-        memcpy(cones + 4 * m, cone, sizeof(cone));
-    }
-    gltf_packed_meshlets* ml = &p->packed.meshlets;
-    ml->present = 1;
-    ml->offsets = gltf_add_accessor(doc, offsets, n, GLTF_UNSIGNED_INT, 4, 0, GLTF_ACCESSOR_BOUNDS);
-    ml->counts = gltf_add_accessor(doc, counts, n, GLTF_UNSIGNED_SHORT, 4, 0, GLTF_ACCESSOR_BOUNDS);
-    ml->bounds = gltf_add_accessor(doc, bounds, n, GLTF_FLOAT, 4, 0, 0);
-    ml->cones = gltf_add_accessor(doc, cones, n, GLTF_FLOAT, 4, 0, 0);
-    ml->vertices = gltf_add_accessor(doc, out.vertices, stats->vertex_count, GLTF_UNSIGNED_INT, 1, 0, GLTF_ACCESSOR_BOUNDS);
-    ml->vertex_tuples = gltf_add_accessor(doc, out.vertex_tuples, stats->vertex_count, GLTF_UNSIGNED_BYTE, 1, 0,
-                                          GLTF_ACCESSOR_BOUNDS);
-    ml->triangles = gltf_add_accessor(doc, out.triangles, stats->triangle_count * 3, GLTF_UNSIGNED_BYTE, 1, 0,
-                                      GLTF_ACCESSOR_BOUNDS);
-    ml->joints = gltf_add_accessor(doc, out.joints, stats->joint_count, GLTF_UNSIGNED_SHORT, 1, 0, GLTF_ACCESSOR_BOUNDS);
-    ml->tuples = gltf_add_accessor(doc, out.tuples, stats->tuple_count, GLTF_UNSIGNED_BYTE, (int)k, 0,
-                                   GLTF_ACCESSOR_BOUNDS);
-    ml->max_vertices = options.max_vertices;
-    ml->max_triangles = options.max_triangles;
-    ml->max_joints = options.max_joints;
+    if (add_meshlet_accessors(doc, &p->packed.meshlets, &out, stats, &options, k, err, err_size)) goto done;
     rc = 0;
 done:
     cli_decoded_skin_free(&decoded);
@@ -347,10 +358,6 @@ done:
     free(out.joints);
     free(out.tuples);
     free(scratch);
-    free(offsets);
-    free(counts);
-    free(bounds);
-    free(cones);
     return rc;
 }
 

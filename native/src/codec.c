@@ -280,8 +280,7 @@ sp_result sp_required_bits(sp_method method, uint32_t influences, double max_spa
 /* ---- encode / decode ---------------------------------------------------------------- */
 
 /* Inlined with a constant k by the batch loop below. */
-SP_INLINE uint64_t encode_one(const sp_codec* codec, const float* weights,
-                                                                 uint32_t k, uint8_t* significant)
+SP_INLINE uint64_t encode_one(const sp_codec* codec, const float* weights, uint32_t k, uint8_t* significant)
 {
     uint64_t q[SP_MAX_INFLUENCES] = {0};
     uint64_t code;
