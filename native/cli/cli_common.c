@@ -15,9 +15,131 @@ static int fail(char* err, size_t err_size, const char* format, ...) {
     return -1;
 }
 
+/* The extension's meshlet arrays read from the file, widened or narrowed to what
+ * sp_packed_meshlets takes (each accessor's component type bounds its values). */
+typedef struct meshlet_arrays {
+    uint32_t *offsets, *counts, *vertices, *wide;
+    uint8_t *vertex_tuples, *triangles, *tuples;
+    uint16_t* joints;
+    sp_packed_meshlets view;
+} meshlet_arrays;
+
+static void meshlet_arrays_free(meshlet_arrays* a) {
+    free(a->offsets);
+    free(a->counts);
+    free(a->vertices);
+    free(a->wide);
+    free(a->vertex_tuples);
+    free(a->triangles);
+    free(a->tuples);
+    free(a->joints);
+    memset(a, 0, sizeof(*a));
+}
+
+/* Reads accessor `index` (component type, components) into a new u32 array; *count elements. */
+static uint32_t* read_u32(const gltf_doc* doc, int index, int type, int components, size_t* count, char* err,
+                          size_t err_size) {
+    if (gltf_read_accessor_u32(doc, index, type, components, count, NULL, err, err_size)) return NULL;
+    uint32_t* out = malloc(*count * (size_t)components * sizeof(uint32_t) + 1);
+    size_t again;
+    if (!out) fail(err, err_size, "out of memory");
+    else if (gltf_read_accessor_u32(doc, index, type, components, &again, out, err, err_size)) {
+        free(out);
+        out = NULL;
+    }
+    return out;
+}
+
+/* The u8 or u16 copy of a u32 array read from an UNSIGNED_BYTE / UNSIGNED_SHORT accessor. */
+static void* narrow(const uint32_t* values, size_t n, size_t bytes) {
+    unsigned char* out = malloc(n * bytes + 1);
+    for (size_t i = 0; out && i < n; ++i) {
+        if (bytes == 1) out[i] = (uint8_t)values[i];
+        else ((uint16_t*)out)[i] = (uint16_t)values[i];
+    }
+    return out;
+}
+
+/* Only the glTF layer here (accessor types, counts that must agree); every meshlet rule is the
+ * library's, checked by sp_validate_packed with the decoded skin. */
+static int read_meshlets(const gltf_doc* doc, const gltf_packed_skin* packed, meshlet_arrays* a, char* err,
+                         size_t err_size) {
+    const gltf_packed_meshlets* ml = &packed->meshlets;
+    uint32_t k = packed->influences;
+    size_t n = 0, n_counts = 0, n_bounds = 0, n_vertices = 0, n_vtuples = 0, n_tri = 0, n_joints = 0, n_tuples = 0;
+    memset(a, 0, sizeof(*a));
+    uint32_t *vtuples = NULL, *triangles = NULL, *joints = NULL, *tuples = NULL;
+    int rc = -1;
+    if (!(a->offsets = read_u32(doc, ml->offsets, GLTF_UNSIGNED_INT, 4, &n, err, err_size)) ||
+        !(a->counts = read_u32(doc, ml->counts, GLTF_UNSIGNED_SHORT, 4, &n_counts, err, err_size)) ||
+        gltf_read_accessor_u32(doc, ml->bounds, GLTF_FLOAT, 4, &n_bounds, NULL, err, err_size) ||
+        !(a->vertices = read_u32(doc, ml->vertices, GLTF_UNSIGNED_INT, 1, &n_vertices, err, err_size)) ||
+        !(vtuples = read_u32(doc, ml->vertex_tuples, GLTF_UNSIGNED_BYTE, 1, &n_vtuples, err, err_size)) ||
+        !(triangles = read_u32(doc, ml->triangles, GLTF_UNSIGNED_BYTE, 1, &n_tri, err, err_size)) ||
+        !(joints = read_u32(doc, ml->joints, GLTF_UNSIGNED_SHORT, 1, &n_joints, err, err_size)) ||
+        !(tuples = read_u32(doc, ml->tuples, GLTF_UNSIGNED_BYTE, (int)k, &n_tuples, err, err_size)))
+        goto done;
+    if (n_counts != n || n_bounds != n || n_vtuples != n_vertices || n_tri % 3) {
+        fail(err, err_size, "meshlets: accessor counts disagree");
+        goto done;
+    }
+    a->vertex_tuples = narrow(vtuples, n_vertices, 1);
+    a->triangles = narrow(triangles, n_tri, 1);
+    a->joints = narrow(joints, n_joints, 2);
+    a->tuples = narrow(tuples, n_tuples * k, 1);
+    if (!a->vertex_tuples || !a->triangles || !a->joints || !a->tuples) {
+        fail(err, err_size, "out of memory");
+        goto done;
+    }
+    sp_packed_meshlets* v = &a->view;
+    v->meshlet_count = n;
+    v->offsets = a->offsets;
+    v->counts = a->counts;
+    v->vertex_entries = n_vertices;
+    v->vertices = a->vertices;
+    v->vertex_tuples = a->vertex_tuples;
+    v->triangle_bytes = n_tri;
+    v->triangles = a->triangles;
+    v->joint_entries = n_joints;
+    v->joints = a->joints;
+    v->tuple_count = n_tuples;
+    v->tuples = a->tuples;
+    v->max_vertices = ml->max_vertices;
+    v->max_triangles = ml->max_triangles;
+    v->max_joints = ml->max_joints;
+    rc = 0;
+done:
+    free(vtuples);
+    free(triangles);
+    free(joints);
+    free(tuples);
+    if (rc) meshlet_arrays_free(a);
+    return rc;
+}
+
+/* What info reports of meshlets that passed validation. */
+static void summarize_meshlets(const sp_packed_meshlets* v, cli_meshlet_summary* summary) {
+    memset(summary, 0, sizeof(*summary));
+    size_t entries = 0;
+    double tuple_bits_sum = 0;
+    for (size_t m = 0; m < v->meshlet_count; ++m) {
+        uint32_t vc = v->counts[4 * m], tc = v->counts[4 * m + 1], jc = v->counts[4 * m + 2], uc = v->counts[4 * m + 3];
+        if (vc > summary->max_vertices) summary->max_vertices = vc;
+        if (tc > summary->max_triangles) summary->max_triangles = tc;
+        if (jc > summary->max_joints) summary->max_joints = jc;
+        summary->palette_entries += jc;
+        tuple_bits_sum += (double)vc * sp_index_bits(uc);
+        entries += vc;
+    }
+    summary->count = v->meshlet_count;
+    summary->mean_joints = v->meshlet_count ? (double)summary->palette_entries / (double)v->meshlet_count : 0;
+    summary->local_tuple_bits_mean = entries ? tuple_bits_sum / (double)entries : 0;
+}
+
 static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
                          uint32_t words_per_vertex, size_t primitive_vertex_count, const uint16_t* lut, size_t lut_size,
-                         size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
+                         size_t skin_joint_count, const sp_packed_meshlets* meshlets, cli_decoded_skin* out,
+                         char* err, size_t err_size) {
     memset(out, 0, sizeof(*out));
     /* Every format rule is the library's (sp_validate_packed); this only passes what the file says. */
     sp_packed_primitive primitive;
@@ -43,6 +165,7 @@ static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, 
     primitive.lut_components = packed->influences;
     primitive.lut_component_bytes = sp_joint_bytes(packed->joint_count); /* gltf_packed_sizes checked the type */
     primitive.skin_joint_count = skin_joint_count;
+    primitive.meshlets = meshlets;
 
     uint32_t k = packed->influences;
     out->joints = (uint16_t*)malloc(vertex_count * k * sizeof(uint16_t) + 1);
@@ -63,6 +186,7 @@ static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, 
     out->influences = k;
     out->words_per_vertex = words_per_vertex;
     out->joint_bytes = primitive.lut_component_bytes;
+    if (meshlets) summarize_meshlets(meshlets, &out->meshlets);
     return 0;
 }
 
@@ -70,7 +194,7 @@ int cli_decode_packed_arrays(const gltf_packed_skin* packed, const uint32_t* wor
                              uint32_t words_per_vertex, const uint16_t* lut, size_t lut_size,
                              size_t skin_joint_count, cli_decoded_skin* out, char* err, size_t err_size) {
     return decode_arrays(packed, words, vertex_count, words_per_vertex, vertex_count, lut, lut_size, skin_joint_count,
-                         out, err, err_size);
+                         NULL, out, err, err_size);
 }
 
 int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
@@ -82,107 +206,20 @@ int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const 
     uint32_t* words = (uint32_t*)malloc(vertex_count * words_per_vertex * sizeof(uint32_t));
     uint16_t* lut = (uint16_t*)malloc(lut_size * packed->influences * sizeof(uint16_t));
     int rc = -1;
+    meshlet_arrays meshlets;
+    memset(&meshlets, 0, sizeof(meshlets));
     if (!words || !lut)
         fail(err, err_size, "out of memory");
-    else if (gltf_read_packed(doc, packed, words, lut, err, err_size) == 0) {
+    else if (gltf_read_packed(doc, packed, words, lut, err, err_size) == 0 &&
+             (!packed->meshlets.present || read_meshlets(doc, packed, &meshlets, err, err_size) == 0)) {
         size_t primitive_vertices = gltf_primitive_vertex_count(doc, mesh, primitive);
         rc = decode_arrays(packed, words, vertex_count, words_per_vertex, primitive_vertices ? primitive_vertices : vertex_count,
-                           lut, lut_size, gltf_mesh_joint_count(doc, mesh), out, err, err_size);
+                           lut, lut_size, gltf_mesh_joint_count(doc, mesh),
+                           packed->meshlets.present ? &meshlets.view : NULL, out, err, err_size);
     }
+    meshlet_arrays_free(&meshlets);
     free(words);
     free(lut);
-    return rc;
-}
-
-int cli_check_meshlets(const gltf_doc* doc, const gltf_packed_skin* packed, size_t vertex_count,
-                       cli_meshlet_summary* summary, char* err, size_t err_size) {
-    const gltf_packed_meshlets* ml = &packed->meshlets;
-    uint32_t k = packed->influences;
-    size_t n = 0, n_counts = 0, n_bounds = 0, n_vertices = 0, n_vtuples = 0, n_tri = 0, n_joints = 0, n_tuples = 0;
-    memset(summary, 0, sizeof(*summary));
-    if (gltf_read_accessor_u32(doc, ml->offsets, GLTF_UNSIGNED_INT, 4, &n, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->counts, GLTF_UNSIGNED_SHORT, 4, &n_counts, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->bounds, GLTF_FLOAT, 4, &n_bounds, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->vertices, GLTF_UNSIGNED_INT, 1, &n_vertices, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->vertex_tuples, GLTF_UNSIGNED_BYTE, 1, &n_vtuples, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->triangles, GLTF_UNSIGNED_BYTE, 1, &n_tri, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->joints, GLTF_UNSIGNED_SHORT, 1, &n_joints, NULL, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->tuples, GLTF_UNSIGNED_BYTE, (int)k, &n_tuples, NULL, err, err_size))
-        return -1;
-    if (n_counts != n || n_bounds != n || n_vtuples != n_vertices || n_tri % 3)
-        return fail(err, err_size, "meshlets: accessor counts disagree");
-    uint32_t* offsets = malloc(n * 4 * sizeof(uint32_t));
-    uint32_t* counts = malloc(n * 4 * sizeof(uint32_t));
-    uint32_t* vertices = malloc(n_vertices * sizeof(uint32_t));
-    uint32_t* vtuples = malloc(n_vertices * sizeof(uint32_t));
-    uint32_t* triangles = malloc(n_tri * sizeof(uint32_t));
-    uint32_t* joints = malloc(n_joints * sizeof(uint32_t));
-    uint32_t* tuples = malloc(n_tuples * k * sizeof(uint32_t));
-    int rc = -1;
-    size_t t;
-    if (!offsets || !counts || !vertices || !vtuples || !triangles || !joints || !tuples) {
-        fail(err, err_size, "out of memory");
-        goto done;
-    }
-    if (gltf_read_accessor_u32(doc, ml->offsets, GLTF_UNSIGNED_INT, 4, &t, offsets, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->counts, GLTF_UNSIGNED_SHORT, 4, &t, counts, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->vertices, GLTF_UNSIGNED_INT, 1, &t, vertices, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->vertex_tuples, GLTF_UNSIGNED_BYTE, 1, &t, vtuples, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->triangles, GLTF_UNSIGNED_BYTE, 1, &t, triangles, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->joints, GLTF_UNSIGNED_SHORT, 1, &t, joints, err, err_size) ||
-        gltf_read_accessor_u32(doc, ml->tuples, GLTF_UNSIGNED_BYTE, (int)k, &t, tuples, err, err_size))
-        goto done;
-    double joint_sum = 0, tuple_bits_sum = 0;
-    size_t entries = 0;
-    for (size_t m = 0; m < n; ++m) {
-        uint64_t vo = offsets[4 * m], to = offsets[4 * m + 1], jo = offsets[4 * m + 2], uo = offsets[4 * m + 3];
-        uint32_t vc = counts[4 * m], tc = counts[4 * m + 1], jc = counts[4 * m + 2], uc = counts[4 * m + 3];
-        if (vo + vc > n_vertices || (to + tc) * 3 > n_tri || jo + jc > n_joints || uo + uc > n_tuples || !vc || !tc ||
-            !jc || !uc || (ml->max_vertices && vc > ml->max_vertices) ||
-            (ml->max_triangles && tc > ml->max_triangles) || (ml->max_joints && jc > ml->max_joints)) {
-            fail(err, err_size, "meshlet %zu: offsets or counts out of range", m);
-            goto done;
-        }
-        for (uint32_t i = 0; i < vc; ++i)
-            if (vertices[vo + i] >= vertex_count || vtuples[vo + i] >= uc) {
-                fail(err, err_size, "meshlet %zu vertex %u: source vertex or local tuple out of range", m, i);
-                goto done;
-            }
-        for (uint32_t i = 0; i < 3 * tc; ++i)
-            if (triangles[3 * to + i] >= vc) {
-                fail(err, err_size, "meshlet %zu: triangle index %u out of range", m, triangles[3 * to + i]);
-                goto done;
-            }
-        for (uint32_t i = 0; i < jc; ++i)
-            if (joints[jo + i] >= packed->joint_count) {
-                fail(err, err_size, "meshlet %zu: palette joint %u out of range", m, joints[jo + i]);
-                goto done;
-            }
-        for (uint32_t i = 0; i < uc * k; ++i)
-            if (tuples[uo * k + i] >= jc) {
-                fail(err, err_size, "meshlet %zu: local tuple entry %u past the palette", m, tuples[uo * k + i]);
-                goto done;
-            }
-        if (vc > summary->max_vertices) summary->max_vertices = vc;
-        if (tc > summary->max_triangles) summary->max_triangles = tc;
-        if (jc > summary->max_joints) summary->max_joints = jc;
-        joint_sum += jc;
-        tuple_bits_sum += (double)vc * sp_index_bits(uc);
-        entries += vc;
-    }
-    summary->count = n;
-    summary->palette_entries = (size_t)joint_sum;
-    summary->mean_joints = n ? joint_sum / (double)n : 0;
-    summary->local_tuple_bits_mean = entries ? tuple_bits_sum / (double)entries : 0;
-    rc = 0;
-done:
-    free(offsets);
-    free(counts);
-    free(vertices);
-    free(vtuples);
-    free(triangles);
-    free(joints);
-    free(tuples);
     return rc;
 }
 

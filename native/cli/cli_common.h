@@ -15,6 +15,15 @@
 
 #define CLI_ERR_SIZE 512
 
+/* What info reports about stored meshlets (compress --json reports the same fields). */
+typedef struct cli_meshlet_summary {
+    size_t count;
+    uint32_t max_vertices, max_triangles, max_joints;
+    size_t palette_entries; /* palette joints summed over meshlets */
+    double mean_joints;
+    double local_tuple_bits_mean; /* mean over meshlet vertex entries of ceil(log2 tuple count) */
+} cli_meshlet_summary;
+
 /* A decoded packed skin: K joints and K weights a vertex, in weight order. */
 typedef struct cli_decoded_skin {
     sp_codec codec;
@@ -25,6 +34,7 @@ typedef struct cli_decoded_skin {
     uint32_t joint_bytes;
     uint16_t* joints;
     float* weights;
+    cli_meshlet_summary meshlets; /* when the primitive has meshlets (validated with the skin) */
 } cli_decoded_skin;
 
 /*
@@ -43,20 +53,6 @@ int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const 
                       cli_decoded_skin* out, char* err, size_t err_size);
 
 void cli_decoded_skin_free(cli_decoded_skin* skin);
-
-/* What info reports about stored meshlets (compress --json reports the same fields). */
-typedef struct cli_meshlet_summary {
-    size_t count;
-    uint32_t max_vertices, max_triangles, max_joints;
-    size_t palette_entries; /* palette joints summed over meshlets */
-    double mean_joints;
-    double local_tuple_bits_mean; /* mean over meshlet vertex entries of ceil(log2 tuple count) */
-} cli_meshlet_summary;
-
-/* Reads and checks the extension's meshlets against each other and the primitive (every index
- * in range, offsets + counts inside the arrays, limits respected). */
-int cli_check_meshlets(const gltf_doc* doc, const gltf_packed_skin* packed, size_t vertex_count,
-                       cli_meshlet_summary* summary, char* err, size_t err_size);
 
 /* Bits a vertex of the LUT costs: lut_size * K * 8 * joint_bytes / vertex_count (as in
  * sp_compressed_skin.lut_bits_per_vertex). */

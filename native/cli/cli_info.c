@@ -123,11 +123,7 @@ static int info_packed(const gltf_doc* doc, size_t mesh, size_t primitive, primi
         info->histogram[nonzero]++;
     }
     info->fallback_difference = NAN;
-    if (info->ext.meshlets.present &&
-        cli_check_meshlets(doc, &info->ext, skin.vertex_count, &info->meshlets, err, err_size)) {
-        cli_decoded_skin_free(&skin);
-        return -1;
-    }
+    if (info->ext.meshlets.present) info->meshlets = skin.meshlets;
 
     gltf_skin_attributes at;
     int rc = 0;
