@@ -23,7 +23,7 @@ const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'w
 const UNSIGNED_BYTE = 5121, UNSIGNED_SHORT = 5123, FLOAT = 5126;
 // The fallback buffer's views start here: three.js fetches a buffer without uri as the page
 // itself, and an offset past any page makes that fetch fail too (docs/extension/README.md).
-const FALLBACK_VIEW_OFFSET = 1 << 24;
+export const FALLBACK_VIEW_OFFSET = 1 << 24;
 
 /** The extension on one primitive: the tuple table accessor and the codec parameters. */
 export class PackedSkin extends ExtensionProperty {
