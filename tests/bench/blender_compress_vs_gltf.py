@@ -29,54 +29,58 @@ def timed(function, repeat):
     return statistics.median(samples), samples
 
 
-def main():
-    args = common.arguments()
-    common.install_addon(args.zip)
-    from skinpack import gather
-    from skinpack.io import storage
-
+def subdivided_player(args):
+    """RE_Player subdivided 3 levels (>= 100k vertices), the modifier applied."""
     obj = common.open_asset(args, "RE_Player_female.blend", "RE_Player")
     subdivision = obj.modifiers.new("bench_subdivision", 'SUBSURF')
     subdivision.levels = 3
     bpy.ops.object.modifier_move_to_index(modifier=subdivision.name, index=0)
     bpy.ops.object.modifier_apply(modifier=subdivision.name)
-    vertex_count = len(obj.data.vertices)
-    common.check(vertex_count >= 100000, "only %d vertices" % vertex_count)
-    elements = sum(len(v.groups) for v in obj.data.vertices)
+    common.check(len(obj.data.vertices) >= 100000, "only %d vertices" % len(obj.data.vertices))
+    return obj
 
-    compress_time, compress_samples = timed(lambda: bpy.ops.skinpack.compress(), 5)
+
+def read_bmesh(obj):
+    mesh = bmesh.new()
+    mesh.from_mesh(obj.data)
+    layer = mesh.verts.layers.deform.active
+    [item for vertex in mesh.verts for item in vertex[layer].items()]
+    mesh.free()
+
+
+def export(obj, path, enabled):
+    bpy.context.scene.skinpack_export.enabled = enabled
+    common.make_active(obj)
+    obj.find_armature().select_set(True)
+    bpy.ops.export_scene.gltf(filepath=path, export_format='GLB', use_selection=True)
+
+
+def measure(args, obj):
+    """Every timing of the report, from one Blender run: {name: seconds}, plus the samples."""
+    from skinpack import gather
+    from skinpack.io import storage
+    times = {}
+    times["compress"], compress_samples = timed(lambda: bpy.ops.skinpack.compress(), 5)
     stats = storage.load_result(obj.data).stats
-    read_time, _ = timed(lambda: gather.read_elements(obj.data), 3)
-
-    def read_bmesh():
-        mesh = bmesh.new()
-        mesh.from_mesh(obj.data)
-        layer = mesh.verts.layers.deform.active
-        [item for vertex in mesh.verts for item in vertex[layer].items()]
-        mesh.free()
-    bmesh_time, _ = timed(read_bmesh, 3)
-
+    times["read"], _ = timed(lambda: gather.read_elements(obj.data), 3)
+    times["bmesh"], _ = timed(lambda: read_bmesh(obj), 3)
     # The other operators at this size (not part of the ratio): previews and the A/B round trip,
     # which must restore all 500k elements bit-exactly.
-    weight_preview_time, _ = timed(lambda: bpy.ops.skinpack.preview_error(mode='WEIGHT'), 3)
-    pose_preview_time, _ = timed(lambda: bpy.ops.skinpack.preview_error(mode='POSE'), 1)
+    times["weight_preview"], _ = timed(lambda: bpy.ops.skinpack.preview_error(mode='WEIGHT'), 3)
+    times["pose_preview"], _ = timed(lambda: bpy.ops.skinpack.preview_error(mode='POSE'), 1)
     bpy.ops.skinpack.clear_preview()
     before = common.weight_snapshot(obj.data)
-    toggle_on_time, _ = timed(lambda: bpy.ops.skinpack.toggle_decoded(), 1)
-    toggle_off_time, _ = timed(lambda: bpy.ops.skinpack.toggle_decoded(), 1)
-    common.assert_same_weights(before, common.weight_snapshot(obj.data), "A/B at %d vertices" % vertex_count)
-
+    times["toggle_on"], _ = timed(lambda: bpy.ops.skinpack.toggle_decoded(), 1)
+    times["toggle_off"], _ = timed(lambda: bpy.ops.skinpack.toggle_decoded(), 1)
+    common.assert_same_weights(before, common.weight_snapshot(obj.data), "A/B at %d vertices" % len(obj.data.vertices))
     path = os.path.join(args.out, "bench_plain.glb")
+    times["export"], export_samples = timed(lambda: export(obj, path, False), 3)
+    times["export_packed"], _ = timed(lambda: export(obj, path, True), 3)
+    return times, stats, compress_samples, export_samples
 
-    def export(enabled):
-        bpy.context.scene.skinpack_export.enabled = enabled
-        common.make_active(obj)
-        obj.find_armature().select_set(True)
-        bpy.ops.export_scene.gltf(filepath=path, export_format='GLB', use_selection=True)
-    export_time, export_samples = timed(lambda: export(False), 3)
-    export_packed_time, _ = timed(lambda: export(True), 3)
 
-    ratio = compress_time / export_time
+def report(obj, times, stats, compress_samples, export_samples):
+    ratio = times["compress"] / times["export"]
     lines = [
         "# Blender add-on benchmark",
         "",
@@ -85,21 +89,21 @@ def main():
         % (platform.processor() or platform.machine(), os.cpu_count(), bpy.app.version_string),
         "",
         "Mesh: `RE_Player` from `RE_Player_female.blend`, subdivided 3 levels: **%d vertices**, %d vertex-group"
-        % (vertex_count, elements),
+        % (len(obj.data.vertices), sum(len(v.groups) for v in obj.data.vertices)),
         "elements, %d deform bones, up to %d vertex groups a vertex." % (stats["joint_count"], _max_influences(obj)),
         "",
         "| step | time (s) |",
         "|---|---|",
-        "| `skinpack.compress` operator (read weights, library, store result) | %.3f |" % compress_time,
-        "| &nbsp;&nbsp;of which reading the vertex groups (one pass over `vertex.groups`) | %.3f |" % read_time,
-        "| Blender glTF export of the mesh + armature, Skinpack off | %.3f |" % export_time,
-        "| Blender glTF export, Skinpack on (fallback: exporter + hook) | %.3f |" % export_packed_time,
-        "| reading the vertex groups through a bmesh deform layer (for comparison) | %.3f |" % bmesh_time,
-        "| `skinpack.preview_error(mode='WEIGHT')` | %.3f |" % weight_preview_time,
+        "| `skinpack.compress` operator (read weights, library, store result) | %.3f |" % times["compress"],
+        "| &nbsp;&nbsp;of which reading the vertex groups (one pass over `vertex.groups`) | %.3f |" % times["read"],
+        "| Blender glTF export of the mesh + armature, Skinpack off | %.3f |" % times["export"],
+        "| Blender glTF export, Skinpack on (fallback: exporter + hook) | %.3f |" % times["export_packed"],
+        "| reading the vertex groups through a bmesh deform layer (for comparison) | %.3f |" % times["bmesh"],
+        "| `skinpack.preview_error(mode='WEIGHT')` | %.3f |" % times["weight_preview"],
         "| `skinpack.preview_error(mode='POSE')` (two depsgraph evaluations, weights swapped and restored) | %.3f |"
-        % pose_preview_time,
+        % times["pose_preview"],
         "| `skinpack.toggle_decoded` on / off (restore checked bit-exact) | %.3f / %.3f |"
-        % (toggle_on_time, toggle_off_time),
+        % (times["toggle_on"], times["toggle_off"]),
         "",
         "**compress / glTF export = %.3f** (target: <= 1; reported, never asserted: timings are not pass/fail)." % ratio,
         "",
@@ -117,7 +121,14 @@ def main():
         "everything after the pass is numpy and the library. Blender's exporter itself loops over every",
         "vertex's groups in Python and does much more per vertex.",
     ]
-    text = "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n", ratio
+
+
+def main():
+    args = common.arguments()
+    common.install_addon(args.zip)
+    obj = subdivided_player(args)
+    text, ratio = report(obj, *measure(args, obj))
     print(text)
     if args.docs:
         with open(os.path.join(args.docs, "benchmarks-blender.md"), "w") as handle:

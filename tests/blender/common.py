@@ -107,6 +107,22 @@ def check(condition, message):
         raise AssertionError(message)
 
 
+def refusal(call, *fragments, traceback_allowed=False):
+    """Runs call, which must fail with a RuntimeError (an operator's error report) whose text
+    holds every fragment and, unless traceback_allowed, no traceback; returns the text."""
+    try:
+        call()
+    except RuntimeError as error:
+        message = str(error)
+    else:
+        raise AssertionError("not refused; expected a report with %s" % (fragments,))
+    check(traceback_allowed or "Traceback" not in message, "traceback instead of a report: %s" % message)
+    for fragment in fragments:
+        check(fragment in message, "report %r lacks %r" % (message, fragment))
+    print("refused: %s" % message.strip().splitlines()[-1])
+    return message
+
+
 def run(main):
     """Runs main() and exits non-zero with the traceback on failure (also outside --python-exit-code)."""
     try:

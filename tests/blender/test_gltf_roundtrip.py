@@ -112,111 +112,126 @@ def cli(args, *command):
     return run.stdout
 
 
+def check_exporter_hook(obj, name, base):
+    """Blender's own File > Export > glTF with the Skinpack section switched on writes packed data."""
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+    via_exporter = base + "_exporter_compact.glb"
+    export_settings = bpy.context.scene.skinpack_export
+    export_settings.enabled, export_settings.mode = True, 'COMPACT'
+    common.make_active(obj)
+    obj.find_armature().select_set(True)
+    bpy.ops.export_scene.gltf(filepath=via_exporter, export_format='GLB', use_selection=True)
+    export_settings.enabled, export_settings.mode = False, 'FALLBACK'
+    check_contract(via_exporter, compact=True)
+    compressed = exporter.last_report.compressed
+    common.check(compressed and all(entry[0] == name for entry in compressed),
+                 "export report does not name %s: %s" % (name, exporter.last_report.compressed))
+
+
+def export_both_modes(obj, base):
+    """Skinpack's export operator in both modes with the error preview on: the heat map (the
+    render colour) must not become COLOR_0. Returns {mode: (path, per-primitive stats)}."""
+    from skinpack.blender.exp import gltf2_skinpack_export as exporter
+    common.make_active(obj)
+    bpy.ops.skinpack.compress()
+    bpy.ops.skinpack.preview_error(mode='WEIGHT')
+    outputs = {}
+    for mode in ("FALLBACK", "COMPACT"):
+        path = "%s_%s.glb" % (base, mode.lower())
+        common.make_active(obj)
+        common.check(bpy.ops.skinpack.export_gltf(filepath=path, mode=mode) == {'FINISHED'}, "export " + mode)
+        outputs[mode] = (path, [stats for _, stats in exporter.last_report.compressed])
+        glb = check_contract(path, mode == 'COMPACT')
+        for _, _, primitive in glb.skinned_primitives():
+            common.check("COLOR_0" not in primitive["attributes"], "%s: the heat map was exported" % path)
+    return outputs
+
+
+HOOK_TO_CLI_STATS = (("vertices", "vertices"), ("unique_tuples", "unique_tuples"), ("tuple_bits", "tuple_bits"),
+                     ("weight_bits", "weight_bits"), ("n", "n"), ("influences", "influences"),
+                     ("joint_count", "joints"))
+
+
+def check_cli_matches(args, name, reference, base, fallback):
+    """The CLI compresses the plain export with the same settings: identical stats and words."""
+    cli_path = base + "_cli.glb"
+    report = json.loads(cli(args, "compress", reference, "-o", cli_path, "--method", "oss", "--vertex-bits", "32",
+                            "--fallback", "--json"))
+    cli_primitives, hook_stats = report["primitives"], fallback[1]
+    common.check(len(cli_primitives) == len(hook_stats), "primitive count: CLI %d, hook %d"
+                 % (len(cli_primitives), len(hook_stats)))
+    for ours, theirs in zip(hook_stats, cli_primitives):
+        for key, cli_key in HOOK_TO_CLI_STATS:
+            common.check(ours[key] == theirs[cli_key], "%s %s: hook %s, CLI %s" % (name, key, ours[key], theirs[cli_key]))
+        common.check(abs(ours["bits_per_vertex"] - theirs["bits_per_vertex"]) < 1e-4, "bits per vertex")
+        common.check(abs(ours["error_bound"] - theirs["max_error_bound"]) < 1e-9, "error bound")
+    ours_glb, cli_glb = common.Glb(fallback[0]), common.Glb(cli_path)
+    for (_, _, p_ours), (_, _, p_cli) in zip(ours_glb.skinned_primitives(), cli_glb.skinned_primitives()):
+        e_ours, e_cli = p_ours["extensions"][EXTENSION], p_cli["extensions"][EXTENSION]
+        for key in ("vertices", "tupleTable"):
+            common.check(np.array_equal(ours_glb.accessor(e_ours[key]), cli_glb.accessor(e_cli[key])),
+                         "%s: %s differs from the CLI's" % (name, key))
+        for key in CONTRACT_KEYS - {"vertices", "tupleTable"}:
+            common.check(e_ours[key] == e_cli[key] or (key == "maxError" and abs(e_ours[key] - e_cli[key]) < 1e-12),
+                         "%s: extension %s: ours %r, CLI %r" % (name, key, e_ours[key], e_cli[key]))
+
+
+def check_decompressed(args, name, plain, path, decoded_path):
+    """skinpack decompress of path: weights within maxError of the exporter's own. Returns the
+    decoded joint->weight maps of every skinned primitive."""
+    cli(args, "decompress", path, "-o", decoded_path)
+    decoded = common.Glb(decoded_path)
+    common.check(validate(args, decoded_path) == [], "decompressed file invalid")
+    packed = common.Glb(path)
+    maps = []
+    for (_, _, p_plain), (_, _, p_dec), (_, _, p_packed) in zip(plain.skinned_primitives(), decoded.skinned_primitives(),
+                                                               packed.skinned_primitives()):
+        extension = p_packed["extensions"][EXTENSION]
+        original = common.joint_weight_maps(*prepared_reference(plain, p_plain, extension))
+        result = common.joint_weight_maps(*skin_of(decoded, p_dec["attributes"]))
+        difference = common.max_map_difference(original, result)
+        print("%s: max |decoded - exported and prepared| %.3g (bound %.3g)" % (path, difference, extension["maxError"]))
+        # float32 inputs and outputs: allow rounding of the last bits on top of the bound
+        common.check(difference <= extension["maxError"] + 1e-6, "%s %s: weight error %g above bound %g"
+                     % (name, path, difference, extension["maxError"]))
+        maps.append(result)
+    return maps
+
+
+def check_asset(args, blend, name):
+    obj = common.open_asset(args, blend, name)
+    base = os.path.join(args.out, name.replace(".", "_"))
+    reference = base + "_plain.glb"
+    export_plain(reference, obj)
+    # Snapshot after the plain export: Blender 3.4's exporter itself clamps weights above 1
+    # in the scene's mesh (RE_Player has four); ours must change nothing beyond that.
+    before = common.weight_snapshot(obj.data)
+    common.check(EXTENSION not in common.Glb(reference).json.get("extensionsUsed", []), "plain export packed")
+    check_exporter_hook(obj, name, base)
+    outputs = export_both_modes(obj, base)
+    common.assert_same_weights(before, common.weight_snapshot(obj.data), name + " after export")
+    for path in (reference, outputs["FALLBACK"][0], outputs["COMPACT"][0]):
+        errors = validate(args, path)
+        common.check(errors == [], "%s: validator errors %s" % (path, errors))
+    check_cli_matches(args, name, reference, base, outputs["FALLBACK"])
+    plain = common.Glb(reference)
+    decoded_maps = {mode: check_decompressed(args, name, plain, outputs[mode][0],
+                                             "%s_%s_decoded.glb" % (base, mode.lower()))
+                    for mode in ("FALLBACK", "COMPACT")}
+    common.check(decoded_maps["FALLBACK"] == decoded_maps["COMPACT"], "modes decode differently")
+    # Import through the hook: the compact file (JOINTS_0/WEIGHTS_0 in the data-less
+    # fallback buffer) gets its weights.
+    for mode in ("COMPACT", "FALLBACK"):
+        check_import(outputs[mode][0], decoded_maps[mode], plain)
+
+
 def main():
     args = common.arguments()
     common.check(bool(args.cli), "the skinpack CLI is not built (native/cli needs libtinygltf-dev)")
     common.install_addon(args.zip)
-    from skinpack.blender.exp import gltf2_skinpack_export as exporter
-
     for blend, name in (("RE_Player_female.blend", "RE_Player"), ("skinned_cylinder.blend", "Cylinder"),
                         ("RobotExpressive.blend", "Hand.L")):
-        obj = common.open_asset(args, blend, name)
-        base = os.path.join(args.out, name.replace(".", "_"))
-        reference = base + "_plain.glb"
-        export_plain(reference, obj)
-        # Snapshot after the plain export: Blender 3.4's exporter itself clamps weights above 1
-        # in the scene's mesh (RE_Player has four); ours must change nothing beyond that.
-        before = common.weight_snapshot(obj.data)
-        common.check(EXTENSION not in common.Glb(reference).json.get("extensionsUsed", []), "plain export packed")
-
-        # Blender's own File > Export > glTF with the Skinpack section switched on: packed.
-        via_exporter = base + "_exporter_compact.glb"
-        export_settings = bpy.context.scene.skinpack_export
-        export_settings.enabled, export_settings.mode = True, 'COMPACT'
-        common.make_active(obj)
-        obj.find_armature().select_set(True)
-        bpy.ops.export_scene.gltf(filepath=via_exporter, export_format='GLB', use_selection=True)
-        export_settings.enabled, export_settings.mode = False, 'FALLBACK'
-        check_contract(via_exporter, compact=True)
-        compressed = exporter.last_report.compressed
-        common.check(compressed and all(entry[0] == name for entry in compressed),
-                     "export report does not name %s: %s" % (name, exporter.last_report.compressed))
-
-        # With the error preview on, the heat map (the render colour) must not become COLOR_0.
-        common.make_active(obj)
-        bpy.ops.skinpack.compress()
-        bpy.ops.skinpack.preview_error(mode='WEIGHT')
-
-        outputs = {}
-        for mode in ("FALLBACK", "COMPACT"):
-            path = "%s_%s.glb" % (base, mode.lower())
-            common.make_active(obj)
-            common.check(bpy.ops.skinpack.export_gltf(filepath=path, mode=mode) == {'FINISHED'}, "export " + mode)
-            outputs[mode] = (path, [stats for _, stats in exporter.last_report.compressed])
-            glb = check_contract(path, mode == 'COMPACT')
-            for _, _, primitive in glb.skinned_primitives():
-                common.check("COLOR_0" not in primitive["attributes"], "%s: the heat map was exported" % path)
-        common.assert_same_weights(before, common.weight_snapshot(obj.data), name + " after export")
-
-        # Khronos validator: no errors in any file.
-        for path in (reference, outputs["FALLBACK"][0], outputs["COMPACT"][0]):
-            errors = validate(args, path)
-            common.check(errors == [], "%s: validator errors %s" % (path, errors))
-
-        # The CLI compresses the plain export with the same settings: identical stats and words.
-        cli_path = base + "_cli.glb"
-        report = json.loads(cli(args, "compress", reference, "-o", cli_path, "--method", "oss", "--vertex-bits", "32",
-                                "--fallback", "--json"))
-        cli_primitives = report["primitives"]
-        hook_stats = outputs["FALLBACK"][1]
-        common.check(len(cli_primitives) == len(hook_stats), "primitive count: CLI %d, hook %d"
-                     % (len(cli_primitives), len(hook_stats)))
-        for ours, theirs in zip(hook_stats, cli_primitives):
-            for key, cli_key in (("vertices", "vertices"), ("unique_tuples", "unique_tuples"),
-                                 ("tuple_bits", "tuple_bits"), ("weight_bits", "weight_bits"), ("n", "n"),
-                                 ("influences", "influences"), ("joint_count", "joints")):
-                common.check(ours[key] == theirs[cli_key], "%s %s: hook %s, CLI %s" % (name, key, ours[key],
-                                                                                     theirs[cli_key]))
-            common.check(abs(ours["bits_per_vertex"] - theirs["bits_per_vertex"]) < 1e-4, "bits per vertex")
-            common.check(abs(ours["error_bound"] - theirs["max_error_bound"]) < 1e-9, "error bound")
-        ours_glb, cli_glb = common.Glb(outputs["FALLBACK"][0]), common.Glb(cli_path)
-        for (_, _, p_ours), (_, _, p_cli) in zip(ours_glb.skinned_primitives(), cli_glb.skinned_primitives()):
-            e_ours, e_cli = p_ours["extensions"][EXTENSION], p_cli["extensions"][EXTENSION]
-            common.check(np.array_equal(ours_glb.accessor(e_ours["vertices"]), cli_glb.accessor(e_cli["vertices"])),
-                         "%s: packed words differ from the CLI's" % name)
-            common.check(np.array_equal(ours_glb.accessor(e_ours["tupleTable"]), cli_glb.accessor(e_cli["tupleTable"])),
-                         "%s: tuple table differs from the CLI's" % name)
-            for key in CONTRACT_KEYS - {"vertices", "tupleTable"}:
-                common.check(e_ours[key] == e_cli[key] or (key == "maxError" and abs(e_ours[key] - e_cli[key]) < 1e-12),
-                             "%s: extension %s: ours %r, CLI %r" % (name, key, e_ours[key], e_cli[key]))
-
-        # skinpack decompress of both files: weights within maxError of the exporter's own.
-        plain = common.Glb(reference)
-        plain_primitives = list(plain.skinned_primitives())
-        decoded_maps = {}
-        for mode in ("FALLBACK", "COMPACT"):
-            decoded_path = "%s_%s_decoded.glb" % (base, mode.lower())
-            cli(args, "decompress", outputs[mode][0], "-o", decoded_path)
-            decoded = common.Glb(decoded_path)
-            common.check(validate(args, decoded_path) == [], "decompressed file invalid")
-            packed = common.Glb(outputs[mode][0])
-            for (_, _, p_plain), (_, _, p_dec), (_, _, p_packed) in zip(plain_primitives, decoded.skinned_primitives(),
-                                                                       packed.skinned_primitives()):
-                bound = p_packed["extensions"][EXTENSION]["maxError"]
-                original = common.joint_weight_maps(*prepared_reference(plain, p_plain, p_packed["extensions"][EXTENSION]))
-                result = common.joint_weight_maps(*skin_of(decoded, p_dec["attributes"]))
-                difference = common.max_map_difference(original, result)
-                print("%s %s: max |decoded - exported and prepared| %.3g (bound %.3g)" % (name, mode, difference, bound))
-                # float32 inputs and outputs: allow rounding of the last bits on top of the bound
-                common.check(difference <= bound + 1e-6, "%s %s: weight error %g above bound %g"
-                             % (name, mode, difference, bound))
-                decoded_maps.setdefault(mode, []).append(result)
-        common.check(decoded_maps["FALLBACK"] == decoded_maps["COMPACT"], "modes decode differently")
-
-        # Import through the hook: the compact file (JOINTS_0/WEIGHTS_0 in the data-less
-        # fallback buffer) gets its weights.
-        for mode in ("COMPACT", "FALLBACK"):
-            check_import(outputs[mode][0], decoded_maps[mode], plain)
+        check_asset(args, blend, name)
 
 
 def check_import(path, decoded_maps, plain):

@@ -17,13 +17,9 @@ import common  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def main():
-    args = common.arguments()
-    common.install_addon(args.zip)
-    from skinpack.io import native
-
-    common.check(native.load() is not None, "library did not load: %s" % native.load_error())
-    layout = json.loads(subprocess.check_output([args.layout], text=True))
+def check_mirrors(native, layout_program):
+    """The ctypes mirrors have the C structs' sizes, field order and offsets."""
+    layout = json.loads(subprocess.check_output([layout_program], text=True))
     for c_name, mirror in native.MIRRORED_STRUCTS.items():
         c_struct = layout[c_name]
         common.check(ctypes.sizeof(mirror) == c_struct["size"],
@@ -36,7 +32,10 @@ def main():
             common.check(offset == c_struct["fields"][name], "%s.%s: ctypes offset %d, C offset %d"
                          % (c_name, name, offset, c_struct["fields"][name]))
 
-    # The load-time ABI check: the mirrors' sizes pass, one wrong size is refused by the library.
+
+def check_abi_and_defaults(native):
+    """The load-time ABI check: the mirrors' sizes pass, one wrong size is refused by the library;
+    defaults come from the library, not from Python."""
     sizes = native._struct_sizes()
     lib = native.load()
     bad = ctypes.c_uint32(0)
@@ -47,20 +46,25 @@ def main():
                                   ctypes.byref(bad)) != native.SP_OK and bad.value == 1, "a wrong size passed")
     common.check(lib.sp_check_abi(native.SP_VERSION + 1, None, 0, ctypes.byref(bad)) != native.SP_OK,
                  "another version passed")
-
-    # Defaults come from the library, not from Python.
     options = native.default_options()
     common.check(native.METHODS[options.method] == "oss" and options.max_influences == 4
                  and options.vertex_bits == 32 and options.merge_dont_care == 1,
                  "unexpected defaults from sp_compress_options_default")
 
-    # A random skin through compress and decompress: the decoded weights are within the
-    # codec's bound of the prepared (sorted, normalised) input, for every method.
+
+def random_skin(vertex_count, joint_count):
     rng = np.random.default_rng(7)
-    vertex_count, joint_count = 5000, 40
     joints = np.stack([rng.choice(joint_count, 4, replace=False) for _ in range(vertex_count)]).astype(np.uint16)
     weights = rng.random((vertex_count, 4)).astype(np.float32) ** 3
     weights /= weights.sum(axis=1, keepdims=True)
+    return joints, weights
+
+
+def check_compress_every_method(native):
+    """A random skin through compress and decompress: the decoded weights are within the
+    codec's bound of the prepared (sorted, normalised) input, for every method."""
+    vertex_count, joint_count = 5000, 40
+    joints, weights = random_skin(vertex_count, joint_count)
     for method in native.METHODS:
         compressed = native.compress(joints, weights, joint_count, native.make_options(method, 4, vertex_bits=48))
         skin = compressed.skin
@@ -78,8 +82,10 @@ def main():
         significant = decoded_weights > 0
         common.check((decoded_joints[significant] == reference_joints[significant]).all(), method + ": joints")
 
-    # Meshlets: the library's defaults, and a limit error that names its triangle. Two triangles
-    # whose vertices use three joints each (one per vertex).
+
+def check_meshlets(native):
+    """Meshlets: the library's defaults, and a limit error that names its triangle. Three
+    triangles whose vertices use one joint each."""
     options = native.meshlet_options()
     common.check((native.MESHLET_BUILDERS[options.builder], options.max_vertices, options.max_triangles,
                   options.max_joints) == ("skin", 64, 124, 32), "unexpected defaults from sp_meshlet_options_default")
@@ -102,7 +108,11 @@ def main():
     else:
         raise AssertionError("a 3-joint triangle fitted a palette of 2")
 
-    # Errors come back as SkinpackError naming the vertex, not as a crash.
+
+def check_error_names_vertex(native):
+    """Errors come back as SkinpackError naming the vertex, not as a crash."""
+    joint_count = 40
+    joints, weights = random_skin(5000, joint_count)
     bad = weights.copy()
     bad[123, 0] = np.nan
     try:
@@ -111,6 +121,18 @@ def main():
         common.check(error.code == native.SP_ERR_NONFINITE_WEIGHT and error.vertex == 123, "error %r" % error)
     else:
         raise AssertionError("NaN weight accepted")
+
+
+def main():
+    args = common.arguments()
+    common.install_addon(args.zip)
+    from skinpack.io import native
+    common.check(native.load() is not None, "library did not load: %s" % native.load_error())
+    check_mirrors(native, args.layout)
+    check_abi_and_defaults(native)
+    check_compress_every_method(native)
+    check_meshlets(native)
+    check_error_names_vertex(native)
 
 
 common.run(main)
