@@ -196,8 +196,9 @@ static ordered_json* byte_range_of(ordered_json& view) {
 
 // Cuts bytes [begin, begin + length) of buffer b when skinpack writes that buffer and no range
 // but view `skip_view`'s overlaps them; later views (and meshopt ranges) move down. Whole 4-byte
-// words only, so every alignment is kept: a range's padding up to the next word goes with it
-// when nothing else uses those bytes, else its last partial word stays. Returns the bytes freed.
+// words only, so every alignment is kept: a range's padding up to the next word (or the buffer's
+// end) goes with it when nothing else uses those bytes, else its last partial word stays. Returns
+// the bytes freed.
 static size_t cut_bytes(gltf_doc* doc, int b, size_t begin, size_t length, size_t skip_view) {
     ordered_json& views = doc->json["bufferViews"];
     std::vector<unsigned char>* bytes = rewritable_bytes(doc, b);
@@ -209,8 +210,9 @@ static size_t cut_bytes(gltf_doc* doc, int b, size_t begin, size_t length, size_
             if (range.first < end && range.second > begin) return true;
         return false;
     };
-    size_t padded = (length + 3) & ~size_t(3); // with the padding after it (a meshopt range's length is any)
-    length = padded <= bytes->size() - begin && !overlaps(begin + padded) ? padded : length & ~size_t(3);
+    // With the padding after it (a meshopt range's length is any), or up to the buffer's end.
+    size_t end = std::min(begin + ((length + 3) & ~size_t(3)), bytes->size());
+    length = !overlaps(end) ? end - begin : length & ~size_t(3);
     if (length == 0 || overlaps(begin + length)) return 0; // shared bytes
     bytes->erase(bytes->begin() + long(begin), bytes->begin() + long(begin + length));
     for (size_t i = 0; i < views.size(); ++i) {
@@ -316,16 +318,30 @@ static size_t reserve_meshopt_fallback(gltf_doc* doc, size_t size) {
     return offset;
 }
 
+// The bytes `item` adds to a .gltf's JSON (indented, as gltf_write_file writes it; a GLB's
+// compact JSON grows by less) when it joins `array` of the root object `key`.
+static size_t json_growth(const char* key, const ordered_json& item) {
+    ordered_json before = ordered_json::object(), after;
+    before[key] = ordered_json::array({ordered_json::object({{"byteLength", 1}})});
+    after = before;
+    after[key].push_back(item);
+    return after.dump(2).size() - before.dump(2).size();
+}
+
 // The JSON bytes that compressing one more view adds: its extension object, and with the first
-// one the fallback buffer and the extension's names in the lists (compact JSON, as in a GLB).
+// one the fallback buffer and the extension's names in the lists.
 static size_t meshopt_json_bytes(const gltf_doc* doc, const char* name, const ordered_json& meshopt) {
-    size_t bytes = meshopt.dump().size() + strlen(",\"extensions\":{\"\":}") + strlen(name);
+    ordered_json view = ordered_json::object({{"byteLength", 1}}), compressed = view;
+    compressed["extensions"][name] = meshopt;
+    size_t bytes = json_growth("bufferViews", compressed) - json_growth("bufferViews", view);
     if (doc->meshopt_fallback_bytes) return bytes;
-    bytes += strlen(",{\"byteLength\":,\"extensions\":{\"\":{\"fallback\":true}}}") + strlen(name) + 8;
+    ordered_json buffer = ordered_json::object({{"byteLength", 1}});
+    buffer["extensions"][name]["fallback"] = true;
+    bytes += json_growth("buffers", buffer);
     for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
         const ordered_json* names = member(doc->json, list);
         if (!names || !names->is_array() || std::find(names->begin(), names->end(), ordered_json(name)) == names->end())
-            bytes += strlen(name) + 3;
+            bytes += json_growth(list, name);
     }
     return bytes;
 }

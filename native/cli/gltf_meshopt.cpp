@@ -78,9 +78,13 @@ static int decode_view(const ordered_json& ext, const unsigned char* source, siz
     else if (mode == "TRIANGLES") rc = meshopt_decodeIndexBuffer(dest, count, stride, source, source_size);
     else if (mode == "INDICES") rc = meshopt_decodeIndexSequence(dest, count, stride, source, source_size);
     else return fail(err, err_size, "bufferView %zu: %s mode \"%s\" is not known", view, name, mode.c_str());
+    if (rc == -1) // the header byte: not this mode's data, or a codec version newer than the library
+        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error -1: not %s data, "
+                    "or a newer encoding than libmeshoptimizer %d supports)", view, name, mode.c_str(),
+                    MESHOPTIMIZER_VERSION);
     if (rc != 0)
-        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error %d; a newer "
-                    "encoding than libmeshoptimizer %d supports?)", view, name, rc, MESHOPTIMIZER_VERSION);
+        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error %d: truncated or "
+                    "corrupt)", view, name, rc);
     if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(dest, count, stride);
     else if (filter == "QUATERNION") meshopt_decodeFilterQuat(dest, count, stride);
     else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(dest, count, stride);
