@@ -651,6 +651,7 @@ int skinpack_cmd_compress(int argc, char** argv) {
     }
     compressed_primitive* prims = NULL;
     int rc = 1;
+    gltf_plan_output(doc, cli_output_is_binary(args.output, gltf_is_binary(doc)));
     long found = find_skinned(doc, &args, &prims);
     if (found < 0) goto done;
     size_t count = (size_t)found;

@@ -38,6 +38,7 @@ struct gltf_doc {
     std::vector<unsigned char> added;   // new binary data (views with GLTF_PENDING_DATA_BUFFER)
     size_t fallback_bytes = 0;          // size of the fallback buffer written for compact mode
     size_t meshopt_fallback_bytes = 0;  // size of the meshopt fallback buffer (compress --meshopt)
+    bool output_binary = false;         // the kind it will be written as (gltf_plan_output)
     std::vector<size_t> released_buffers; // input buffers that held views skinpack removed: dropped if unused
     bool edited = false;                // anything changed since loading
 };

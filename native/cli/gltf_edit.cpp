@@ -318,14 +318,17 @@ static size_t reserve_meshopt_fallback(gltf_doc* doc, size_t size) {
     return offset;
 }
 
-// The bytes `item` adds to a .gltf's JSON (indented, as gltf_write_file writes it; a GLB's
-// compact JSON grows by less) when it joins `array` of the root object `key`.
-static size_t json_growth(const char* key, const ordered_json& item) {
+extern "C" void gltf_plan_output(gltf_doc* doc, int binary) { doc->output_binary = binary != 0; }
+
+// The bytes `item` adds to the JSON when it joins the array `key` of the root object, written as
+// gltf_write_file writes it (compact in a GLB, indented in a .gltf).
+static size_t json_growth(const gltf_doc* doc, const char* key, const ordered_json& item) {
     ordered_json before = ordered_json::object(), after;
     before[key] = ordered_json::array({ordered_json::object({{"byteLength", 1}})});
     after = before;
     after[key].push_back(item);
-    return after.dump(2).size() - before.dump(2).size();
+    int indent = doc->output_binary ? -1 : 2;
+    return after.dump(indent).size() - before.dump(indent).size();
 }
 
 // The JSON bytes that compressing one more view adds: its extension object, and with the first
@@ -333,18 +336,21 @@ static size_t json_growth(const char* key, const ordered_json& item) {
 static size_t meshopt_json_bytes(const gltf_doc* doc, const char* name, const ordered_json& meshopt) {
     ordered_json view = ordered_json::object({{"byteLength", 1}}), compressed = view;
     compressed["extensions"][name] = meshopt;
-    size_t bytes = json_growth("bufferViews", compressed) - json_growth("bufferViews", view);
+    size_t bytes = json_growth(doc, "bufferViews", compressed) - json_growth(doc, "bufferViews", view);
     if (doc->meshopt_fallback_bytes) return bytes;
     ordered_json buffer = ordered_json::object({{"byteLength", 1}});
     buffer["extensions"][name]["fallback"] = true;
-    bytes += json_growth("buffers", buffer);
+    bytes += json_growth(doc, "buffers", buffer);
     for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
         const ordered_json* names = member(doc->json, list);
         if (!names || !names->is_array() || std::find(names->begin(), names->end(), ordered_json(name)) == names->end())
-            bytes += json_growth(list, name);
+            bytes += json_growth(doc, list, name);
     }
     return bytes;
 }
+
+// The bytes `size` bytes of binary data take in the output: as they are in a GLB, base64 in a .gltf.
+static size_t stored_size(const gltf_doc* doc, size_t size) { return doc->output_binary ? size : (size + 2) / 3 * 4; }
 
 // Points bufferView JSON `view` at count elements of stride bytes stored meshopt-compressed: the
 // encoded bytes in the new data, the view in the meshopt fallback buffer. false (nothing placed)
@@ -362,7 +368,8 @@ static bool place_meshopt_view(gltf_doc* doc, ordered_json& view, const void* da
     meshopt["byteStride"] = stride;
     meshopt["mode"] = "ATTRIBUTES";
     meshopt["count"] = count;
-    if (encoded.size() + meshopt_json_bytes(doc, name, meshopt) >= count * stride) return false;
+    if (stored_size(doc, encoded.size()) + meshopt_json_bytes(doc, name, meshopt) >= stored_size(doc, count * stride))
+        return false;
     meshopt["byteOffset"] = reserve(doc, encoded.data(), encoded.size());
     view["buffer"] = GLTF_PENDING_MESHOPT_FALLBACK_BUFFER;
     view["byteOffset"] = reserve_meshopt_fallback(doc, count * stride);

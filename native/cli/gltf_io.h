@@ -148,6 +148,9 @@ int gltf_read_accessor_u32(const gltf_doc* doc, int accessor, int component_type
  */
 int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, int component_type, int components,
                       int normalized, int flags);
+/* The kind of file doc will be written as (1: .glb); GLTF_ACCESSOR_MESHOPT weighs the JSON and
+ * base64 sizes of that kind. Default: the input's kind. */
+void gltf_plan_output(gltf_doc* doc, int binary);
 /* 1 if this build can write meshopt-compressed views (libmeshoptimizer, vertex codec version 0). */
 int gltf_meshopt_supported(void);
 /* Bytes an accessor's view occupies in the file: its meshopt-compressed length, or byteLength. */
