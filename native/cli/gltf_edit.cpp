@@ -740,8 +740,10 @@ static void place_new_data(const gltf_doc* doc, ordered_json& json, bool binary,
             data_buffer = long(buffers.size() - 1);
         }
     }
-    long fallback = add_fallback_buffer(json, doc->fallback_bytes, GLTF_EXTENSION_NAME);
+    // Ours last: when decompress cannot remove the packed views (a file with extensions whose
+    // references are unknown), the meshopt views stay valid and our fallback buffer can still go.
     long meshopt_fallback = add_fallback_buffer(json, doc->meshopt_fallback_bytes, gltf_meshopt_extension_for(doc));
+    long fallback = add_fallback_buffer(json, doc->fallback_bytes, GLTF_EXTENSION_NAME);
     if (!json.contains("bufferViews")) return;
     for (ordered_json& view : json["bufferViews"]) {
         resolve_pending(view, data_buffer, base, fallback, meshopt_fallback);
