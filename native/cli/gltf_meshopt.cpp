@@ -15,10 +15,6 @@
 
 static const char* const MESHOPT_NAMES[] = {"EXT_meshopt_compression", "KHR_meshopt_compression"};
 
-// The header byte of meshoptimizer's vertex codec version 0, the only one EXT_meshopt_compression
-// allows (KHR_meshopt_compression also allows 0xa1, but version 0 is valid for both).
-static const unsigned char VERTEX_CODEC_V0 = 0xa0;
-
 const char* gltf_meshopt_extension_for(const gltf_doc* doc) {
     auto used = doc->json.find("extensionsUsed");
     if (used != doc->json.end() && used->is_array())
@@ -29,6 +25,9 @@ const char* gltf_meshopt_extension_for(const gltf_doc* doc) {
 
 bool gltf_meshopt_encode_attributes(const void* data, size_t count, size_t stride, std::vector<unsigned char>* out) {
 #ifdef SKINPACK_HAVE_MESHOPT
+    // The header byte of the vertex codec's version 0, the only one EXT_meshopt_compression allows
+    // (KHR_meshopt_compression also allows 0xa1, but version 0 is valid for both).
+    const unsigned char VERTEX_CODEC_V0 = 0xa0;
     // ATTRIBUTES mode: byteStride a multiple of 4, at most 256 (EXT_meshopt_compression).
     if (!data || count == 0 || stride == 0 || stride % 4 || stride > 256) return false;
     out->resize(meshopt_encodeVertexBufferBound(count, stride));
