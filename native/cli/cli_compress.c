@@ -70,11 +70,11 @@ static void compress_usage(FILE* out) {
             "  --fallback           keep JOINTS_0/WEIGHTS_0, extension optional (default)\n"
             "  --compact            remove them, extension required\n"
             "  --meshlets           also store skin-aware meshlets (palettes, local tuple tables)\n"
-            "  --meshopt            meshopt-compress the packed words and tuple table where that is smaller\n"
-            "                       (EXT_meshopt_compression, required; KHR_ if the input uses it)\n"
             "  --meshlet-vertices N   meshlet vertex limit, 3..%d (default %u)\n"
             "  --meshlet-triangles N  meshlet triangle limit, 1..%d (default %u)\n"
             "  --meshlet-joints N     palette cap: joints a meshlet may use, 1..%d (default %u)\n"
+            "  --meshopt            meshopt-compress the packed words and tuple table where that is smaller\n"
+            "                       (EXT_meshopt_compression, required; KHR_ if the input uses it)\n"
             "  --exact-tuples       no don't-care sharing: zero-weight slots keep their joints\n"
             "  --json               machine-readable report on stdout\n"
             "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n",

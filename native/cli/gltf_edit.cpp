@@ -279,7 +279,6 @@ static size_t cut_accessor_bytes(gltf_doc* doc, size_t accessor_index, size_t vi
 
 static void declare(gltf_doc* doc, const char* list_name, const char* name, bool present);
 
-
 // Reserves size bytes, 4-aligned, in the new data (or the fallback buffer); returns the offset.
 static size_t reserve(gltf_doc* doc, const void* data, size_t size) {
     if (!data) {
