@@ -3,7 +3,8 @@
 //  * three.js GLTFLoader with SkinpackGLTFPlugin in headless Chromium: with
 //    loader.setMeshoptDecoder(MeshoptDecoder) (three/addons/libs/meshopt_decoder.module.js) the
 //    plugin reads the words through the parser, so GPU and CPU decode get exactly the words and
-//    skin of the same file without --meshopt; without the decoder the load is rejected;
+//    skin of the same file without --meshopt; without the decoder the load is rejected; the
+//    viewer (web/viewer) sets the decoder and opens them;
 //  * glTF-Transform with EXTMeshoptCompression registered beside SkinpackPackedSkin: read,
 //    written and decompressed again, every vertex keeps its skin; without it the read is refused.
 import { test, before, after } from 'node:test';
@@ -101,6 +102,21 @@ for (const mode of MODES) {
     assert.match(result.error || '', /setMeshoptDecoder/);
   });
 }
+
+test('the viewer opens --meshopt files (its loader has the meshopt decoder)', { skip: !CHROMIUM && 'no chromium' }, async () => {
+  const viewer = await page.browser.newPage();
+  try {
+    for (const mode of MODES) {
+      await viewer.goto(`${page.url}/viewer/?file=/files/${basename(cases[mode].meshopt.packed)}`);
+      await viewer.waitForFunction(() => window.skinpackViewer && !document.getElementById('status').textContent.startsWith('Loading') &&
+                                         document.getElementById('status').textContent !== '', null, { timeout: 60000 });
+      assert.equal(await viewer.locator('#status.error').count(), 0, await viewer.locator('#status').innerText());
+      assert.match(await viewer.locator('#meshes').innerText(), /GPU decode/);
+    }
+  } finally {
+    await viewer.close();
+  }
+});
 
 // ---- glTF-Transform ----------------------------------------------------------------------
 
