@@ -35,7 +35,7 @@ typedef struct compressed_primitive {
     double input_bits_per_vertex;  /* JOINTS_n + WEIGHTS_n as stored in the input */
     double output_bits_per_vertex; /* vertex words + tuple table as stored in the output */
     size_t packed_bytes;           /* bytes of the vertex words + tuple table (as the GPU holds them) */
-    size_t stored_packed_bytes;    /* the bytes they take in the file (less with --meshopt) */
+    size_t stored_packed_bytes;    /* the bytes stored for them (less with --meshopt; base64 in a .gltf adds 1/3) */
     sp_meshlet_stats meshlet_stats; /* --meshlets */
 } compressed_primitive;
 

@@ -18,8 +18,7 @@ import { SkinpackPackedSkin } from '../../web/gltf-transform/SkinpackPackedSkin.
 import { SKINPACK_EXTENSION } from '../../web/src/decode.js';
 
 const base = new URL('../../web/node_modules/', import.meta.url);
-const { EXTMeshoptCompression } = await import(new URL('@gltf-transform/extensions/dist/index.modern.js', base))
-  .catch(() => import(new URL('@gltf-transform/extensions/dist/index.js', base)));
+const { EXTMeshoptCompression } = await import(new URL('@gltf-transform/extensions/dist/index.js', base));
 const { MeshoptDecoder, MeshoptEncoder } = await import(new URL('meshoptimizer/index.js', base));
 
 const fox = ASSETS.find((a) => basename(a) === 'Fox.glb');
@@ -82,7 +81,7 @@ async function loadInPage(url, decode, withDecoder) {
 for (const mode of MODES) {
   for (const decode of ['gpu', 'cpu']) {
     test(`three.js + SkinpackGLTFPlugin (${decode}) with setMeshoptDecoder: ${mode} --meshopt file has the words and skin of the file without`, { skip: !CHROMIUM && 'no chromium' }, async () => {
-      const { meshopt, plain, } = cases[mode];
+      const { meshopt, plain } = cases[mode];
       const result = await loadInPage(`/files/${basename(meshopt.packed)}`, decode, true);
       assert.equal(result.error, undefined, result.error);
       assert.equal(result.meshes.length, 1);
