@@ -1,6 +1,8 @@
 // meshopt_unpack.mjs - writes a GLB's EXT_meshopt_compression bufferViews out decoded, with the
 // npm meshoptimizer decoder (independent of skinpack's libmeshoptimizer path): the tests' plain
-// reference for gltfpack -c/-cc files. Every view is copied into one new BIN chunk.
+// reference for gltfpack -c/-cc files (and skinpack compress --meshopt). Every view with data is
+// copied into one new BIN chunk; views of other data-less buffers (skinpack's compact fallback
+// buffer) stay data-less.
 //   node tools/meshopt_unpack.mjs IN.glb OUT.glb
 import { readFileSync, writeFileSync } from 'node:fs';
 import { MeshoptDecoder } from 'meshoptimizer';
@@ -24,11 +26,17 @@ const source = (index) => {
 await MeshoptDecoder.ready;
 const NAMES = ['EXT_meshopt_compression', 'KHR_meshopt_compression'];
 const pieces = [];
+const kept = new Map(); // data-less buffer -> its index in the output
+const buffers = json.buffers;
 let size = 0;
 for (const view of json.bufferViews) {
   const name = NAMES.find((n) => view.extensions && view.extensions[n]);
   let bytes;
-  if (name) {
+  if (!name && view.buffer > 0 && buffers[view.buffer].uri === undefined) {
+    if (!kept.has(view.buffer)) kept.set(view.buffer, kept.size + 1);
+    view.buffer = kept.get(view.buffer);
+    continue;
+  } else if (name) {
     const ext = view.extensions[name];
     bytes = new Uint8Array(ext.count * ext.byteStride);
     const data = source(ext.buffer).subarray(ext.byteOffset ?? 0, (ext.byteOffset ?? 0) + ext.byteLength);
@@ -49,7 +57,7 @@ for (const view of json.bufferViews) {
 size = (size + 3) & ~3;
 const out = new Uint8Array(size);
 for (const [offset, bytes] of pieces) out.set(bytes, offset);
-json.buffers = [{ byteLength: size }];
+json.buffers = [{ byteLength: size }, ...[...kept.keys()].map((b) => buffers[b])];
 for (const key of ['extensionsUsed', 'extensionsRequired']) {
   if (!json[key]) continue;
   json[key] = json[key].filter((n) => !NAMES.includes(n));

@@ -18,6 +18,7 @@ typedef struct compress_args {
     int compact;
     int json;
     int meshlets; /* --meshlets: also write skin-aware meshlets */
+    int meshopt;  /* --meshopt: packed words (and tuple table) meshopt-compressed where that is smaller */
     int weight_bits_given; /* --weight-bits (0 in options.weight_bits means "not given") */
     sp_meshlet_options meshlet_options; /* --meshlet-vertices/-triangles/-joints over the library's defaults */
     const char* meshlet_limit;          /* the first of those options given, for the error without --meshlets */
@@ -33,6 +34,8 @@ typedef struct compressed_primitive {
     sp_compressed_skin skin;
     double input_bits_per_vertex;  /* JOINTS_n + WEIGHTS_n as stored in the input */
     double output_bits_per_vertex; /* vertex words + tuple table as stored in the output */
+    size_t packed_bytes;           /* bytes of the vertex words + tuple table (as the GPU holds them) */
+    size_t stored_packed_bytes;    /* the bytes stored for them (less with --meshopt; base64 in a .gltf adds 1/3) */
     sp_meshlet_stats meshlet_stats; /* --meshlets */
 } compressed_primitive;
 
@@ -70,6 +73,8 @@ static void compress_usage(FILE* out) {
             "  --meshlet-vertices N   meshlet vertex limit, 3..%d (default %u)\n"
             "  --meshlet-triangles N  meshlet triangle limit, 1..%d (default %u)\n"
             "  --meshlet-joints N     palette cap: joints a meshlet may use, 1..%d (default %u)\n"
+            "  --meshopt            meshopt-compress the packed words and tuple table where that is smaller\n"
+            "                       (EXT_meshopt_compression, required; KHR_ if the input uses it)\n"
             "  --exact-tuples       no don't-care sharing: zero-weight slots keep their joints\n"
             "  --json               machine-readable report on stdout\n"
             "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n",
@@ -215,6 +220,8 @@ static int parse_args(int argc, char** argv, compress_args* args) {
             args->json = 1;
         } else if (strcmp(a, "--meshlets") == 0) {
             args->meshlets = 1;
+        } else if (strcmp(a, "--meshopt") == 0) {
+            args->meshopt = 1;
         } else if (strcmp(a, "--exact-tuples") == 0) {
             args->options.merge_dont_care = 0;
         } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -233,6 +240,11 @@ static int parse_args(int argc, char** argv, compress_args* args) {
     }
     if (budgets > 1) {
         fprintf(stderr, "Error: give at most one of --vertex-bits, --weight-bits, --max-error\n");
+        return -1;
+    }
+    if (args->meshopt && !gltf_meshopt_supported()) {
+        fprintf(stderr, "Error: --meshopt needs libmeshoptimizer writing vertex codec version 0 "
+                "(EXT_meshopt_compression); this skinpack was built without it\n");
         return -1;
     }
     if (check_budget(args)) return -1;
@@ -436,9 +448,14 @@ static int compress_primitive(gltf_doc* doc, const compress_args* args, compress
         for (size_t i = 0; i < lut_entries; ++i) narrow[i] = (uint8_t)lut[i];
         lut_type = GLTF_UNSIGNED_BYTE;
     }
-    p->packed.vertices = gltf_add_accessor(doc, words, vc, GLTF_UNSIGNED_INT, (int)s->words_per_vertex, 0, 0);
+    int meshopt = args->meshopt ? GLTF_ACCESSOR_MESHOPT : 0;
+    p->packed.vertices = gltf_add_accessor(doc, words, vc, GLTF_UNSIGNED_INT, (int)s->words_per_vertex, 0, meshopt);
     /* no min/max on the words: bit fields, and glTF does not ask for them */
-    p->packed.tuple_table = gltf_add_accessor(doc, lut, s->lut_size, lut_type, (int)k, 0, GLTF_ACCESSOR_BOUNDS);
+    p->packed.tuple_table = gltf_add_accessor(doc, lut, s->lut_size, lut_type, (int)k, 0,
+                                              GLTF_ACCESSOR_BOUNDS | meshopt);
+    p->packed_bytes = vc * 4 * s->words_per_vertex + lut_entries * (size_t)s->joint_bytes;
+    p->stored_packed_bytes = gltf_stored_view_bytes(doc, p->packed.vertices) +
+                             gltf_stored_view_bytes(doc, p->packed.tuple_table);
     p->input_bits_per_vertex = at->stored_bits_per_vertex;
     p->output_bits_per_vertex = 32.0 * s->words_per_vertex + s->lut_bits_per_vertex;
     rc = 0;
@@ -494,6 +511,7 @@ static void print_json(const compress_args* args, const compressed_primitive* pr
         cli_json_number(stdout, s->quantization.rms_error);
         printf(", \"max_pruning_error\": ");
         cli_json_number(stdout, s->prepare.max_pruning_error);
+        printf(", \"packed_bytes\": %zu, \"stored_packed_bytes\": %zu", p->packed_bytes, p->stored_packed_bytes);
         printf(", \"pruned_vertices\": %zu, \"influence_histogram\": [", s->prepare.pruned_vertices);
         for (int c = 0; c <= SP_MAX_INPUT_INFLUENCES; ++c)
             printf("%s%zu", c ? ", " : "", s->prepare.influence_histogram[c]);
@@ -514,7 +532,8 @@ static void print_json(const compress_args* args, const compressed_primitive* pr
     cli_json_number(stdout, vertices ? in_bits / (double)vertices : 0);
     printf(",\n  \"output_bits_per_vertex\": ");
     cli_json_number(stdout, vertices ? out_bits / (double)vertices : 0);
-    printf(",\n  \"input_bytes\": %zu,\n  \"output_bytes\": %zu\n}\n", input_bytes, output_bytes);
+    printf(",\n  \"meshopt\": %s,\n  \"input_bytes\": %zu,\n  \"output_bytes\": %zu\n}\n",
+           args->meshopt ? "true" : "false", input_bytes, output_bytes);
 }
 
 static void print_table(const compress_args* args, const compressed_primitive* prims, size_t count,
@@ -539,6 +558,9 @@ static void print_table(const compress_args* args, const compressed_primitive* p
                    "tuple index %u -> %.2f bits\n", p->meshlet_stats.meshlet_count, p->meshlet_stats.max_vertices,
                    p->meshlet_stats.max_triangles, p->meshlet_stats.max_joints, p->meshlet_stats.mean_joints,
                    s->tuple_bits, p->meshlet_stats.local_tuple_bits_mean);
+        if (args->meshopt)
+            printf("            meshopt: words + tuple table %zu -> %zu bytes in the file\n", p->packed_bytes,
+                   p->stored_packed_bytes);
     }
     printf("%s mode; bits/v out = packed words + tuple table%s. file: %zu -> %zu bytes\n",
            args->compact ? "compact" : "fallback",
@@ -605,6 +627,8 @@ static int compress_all(gltf_doc* doc, const compress_args* args, compressed_pri
             p->packed = first->packed;
             p->input_bits_per_vertex = first->input_bits_per_vertex;
             p->output_bits_per_vertex = first->output_bits_per_vertex;
+            p->packed_bytes = first->packed_bytes;
+            p->stored_packed_bytes = first->stored_packed_bytes;
             p->meshlet_stats = first->meshlet_stats;
         } else if (compress_primitive(doc, args, p, err, sizeof(err))) {
             fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", args->input, p->mesh, p->primitive,
@@ -627,6 +651,7 @@ int skinpack_cmd_compress(int argc, char** argv) {
     }
     compressed_primitive* prims = NULL;
     int rc = 1;
+    gltf_plan_output(doc, cli_output_is_binary(args.output, gltf_is_binary(doc)));
     long found = find_skinned(doc, &args, &prims);
     if (found < 0) goto done;
     size_t count = (size_t)found;

@@ -24,6 +24,7 @@ using ordered_json = nlohmann::ordered_json;
 // A new bufferView's "buffer" before writing decides where its bytes go (see gltf_edit.cpp).
 #define GLTF_PENDING_DATA_BUFFER (-1)     // offset into gltf_doc::added
 #define GLTF_PENDING_FALLBACK_BUFFER (-2) // offset into the fallback buffer (no data)
+#define GLTF_PENDING_MESHOPT_FALLBACK_BUFFER (-3) // offset into the meshopt fallback buffer (no data)
 
 struct gltf_doc {
     tinygltf::Model model;              // the input as tinygltf reads it: never edited
@@ -36,6 +37,9 @@ struct gltf_doc {
     std::map<size_t, std::vector<unsigned char>> cut_data; // data: uri buffers with bytes cut: their new bytes
     std::vector<unsigned char> added;   // new binary data (views with GLTF_PENDING_DATA_BUFFER)
     size_t fallback_bytes = 0;          // size of the fallback buffer written for compact mode
+    size_t meshopt_fallback_bytes = 0;  // size of the meshopt fallback buffer (compress --meshopt)
+    bool output_binary = false;         // the kind it will be written as (gltf_plan_output)
+    std::vector<size_t> released_buffers; // input buffers that held views skinpack removed: dropped if unused
     bool edited = false;                // anything changed since loading
 };
 
@@ -68,6 +72,15 @@ double gltf_read_component(const gltf_element_view& view, size_t element, size_t
 
 // Decodes every EXT_/KHR_meshopt_compression bufferView into tinygltf's model (gltf_meshopt.cpp).
 int gltf_decode_meshopt(gltf_doc* doc, char* err, size_t err_size);
+// The EXT_/KHR_meshopt_compression object of a bufferView (its name in *name), or nullptr.
+const ordered_json* gltf_meshopt_of(const ordered_json& view, const char** name);
+// The meshopt extension skinpack writes into doc: KHR_meshopt_compression when the input uses it,
+// else EXT_meshopt_compression.
+const char* gltf_meshopt_extension_for(const gltf_doc* doc);
+// ATTRIBUTES-mode encoding (vertex codec version 0) of count elements of stride bytes into *out.
+// false when stride does not allow the mode (a multiple of 4, at most 256) or the library
+// cannot write version 0.
+bool gltf_meshopt_encode_attributes(const void* data, size_t count, size_t stride, std::vector<unsigned char>* out);
 
 // The JSON array doc->json[key], created empty when missing.
 ordered_json& gltf_json_array(gltf_doc* doc, const char* key);

@@ -172,14 +172,12 @@ static void used_ranges(const gltf_doc* doc, int b, size_t skip_view, std::vecto
             size_t offset = json_size(view, "byteOffset");
             out->push_back({offset, offset + json_size(view, "byteLength")});
         }
-        const ordered_json* extensions = member(view, "extensions");
-        for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-            const ordered_json* meshopt = extensions ? member(*extensions, name) : nullptr;
-            const ordered_json* source = meshopt ? member(*meshopt, "buffer") : nullptr;
-            if (i != skip_view && source && source->is_number_integer() && source->get<int>() == b) {
-                size_t offset = json_size(*meshopt, "byteOffset");
-                out->push_back({offset, offset + json_size(*meshopt, "byteLength")});
-            }
+        const char* name = nullptr;
+        const ordered_json* meshopt = gltf_meshopt_of(view, &name);
+        const ordered_json* source = meshopt ? member(*meshopt, "buffer") : nullptr;
+        if (i != skip_view && source && source->is_number_integer() && source->get<int>() == b) {
+            size_t offset = json_size(*meshopt, "byteOffset");
+            out->push_back({offset, offset + json_size(*meshopt, "byteLength")});
         }
     }
 }
@@ -189,41 +187,41 @@ static void shift_offset(ordered_json& object, size_t from, size_t by) {
     if (offset >= from && object.contains("byteOffset")) object["byteOffset"] = offset - by;
 }
 
-// Cuts the bytes of bufferView `view` out of its buffer when skinpack writes that buffer and no
-// other range overlaps them; later views (and meshopt ranges) move down. Whole 4-byte words
-// only, so every alignment is kept. Returns the bytes freed.
 // The range a view's bytes occupy: its own, or for a meshopt view the compressed range.
 static ordered_json* byte_range_of(ordered_json& view) {
-    ordered_json* extensions = view.contains("extensions") ? &view["extensions"] : nullptr;
-    for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"})
-        if (extensions && extensions->is_object() && extensions->contains(name)) return &(*extensions)[name];
-    return &view;
+    const char* name = nullptr;
+    const ordered_json* meshopt = gltf_meshopt_of(view, &name);
+    return meshopt ? const_cast<ordered_json*>(meshopt) : &view;
 }
 
 // Cuts bytes [begin, begin + length) of buffer b when skinpack writes that buffer and no range
 // but view `skip_view`'s overlaps them; later views (and meshopt ranges) move down. Whole 4-byte
-// words only, so every alignment is kept. Returns the bytes freed.
+// words only, so every alignment is kept: a range's padding up to the next word (or the buffer's
+// end) goes with it when nothing else uses those bytes, else its last partial word stays. Returns
+// the bytes freed.
 static size_t cut_bytes(gltf_doc* doc, int b, size_t begin, size_t length, size_t skip_view) {
     ordered_json& views = doc->json["bufferViews"];
     std::vector<unsigned char>* bytes = rewritable_bytes(doc, b);
-    length &= ~size_t(3);
-    if (!bytes || begin % 4 || length == 0 || begin + length > bytes->size()) return 0;
+    if (!bytes || begin % 4 || begin + length > bytes->size()) return 0;
     std::vector<std::pair<size_t, size_t>> used;
     used_ranges(doc, b, skip_view, &used);
-    for (const auto& range : used)
-        if (range.first < begin + length && range.second > begin) return 0; // shared bytes
+    auto overlaps = [&](size_t end) {
+        for (const auto& range : used)
+            if (range.first < end && range.second > begin) return true;
+        return false;
+    };
+    // With the padding after it (a meshopt range's length is any), or up to the buffer's end.
+    size_t end = std::min(begin + ((length + 3) & ~size_t(3)), bytes->size());
+    length = !overlaps(end) ? end - begin : length & ~size_t(3);
+    if (length == 0 || overlaps(begin + length)) return 0; // shared bytes
     bytes->erase(bytes->begin() + long(begin), bytes->begin() + long(begin + length));
     for (size_t i = 0; i < views.size(); ++i) {
         ordered_json& other = views[i];
         const ordered_json* ob = member(other, "buffer");
         if (i != skip_view && ob && ob->is_number_integer() && ob->get<int>() == b) shift_offset(other, begin + length, length);
-        ordered_json* extensions = other.contains("extensions") ? &other["extensions"] : nullptr;
-        for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-            if (!extensions || !extensions->is_object() || !extensions->contains(name)) continue;
-            ordered_json& meshopt = (*extensions)[name];
-            const ordered_json* source = member(meshopt, "buffer");
-            if (source && source->is_number_integer() && source->get<int>() == b) shift_offset(meshopt, begin + length, length);
-        }
+        ordered_json* meshopt = byte_range_of(other);
+        const ordered_json* source = meshopt != &other ? member(*meshopt, "buffer") : nullptr;
+        if (source && source->is_number_integer() && source->get<int>() == b) shift_offset(*meshopt, begin + length, length);
     }
     return length;
 }
@@ -279,6 +277,7 @@ static size_t cut_accessor_bytes(gltf_doc* doc, size_t accessor_index, size_t vi
 
 // ---- new data ----
 
+static void declare(gltf_doc* doc, const char* list_name, const char* name, bool present);
 
 // Reserves size bytes, 4-aligned, in the new data (or the fallback buffer); returns the offset.
 static size_t reserve(gltf_doc* doc, const void* data, size_t size) {
@@ -303,10 +302,83 @@ static void place_view(gltf_doc* doc, ordered_json& view, const void* data, size
     view.erase("byteStride");
     if (flags & GLTF_ACCESSOR_VERTEX_ATTRIBUTE) view["target"] = 34962; // ARRAY_BUFFER
     else view.erase("target");
-    if (view.contains("extensions") && view["extensions"].is_object()) { // its meshopt data went with the old bytes
-        for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) view["extensions"].erase(name);
+    const char* meshopt = nullptr;
+    if (gltf_meshopt_of(view, &meshopt)) { // its meshopt data went with the old bytes
+        view["extensions"].erase(meshopt);
         if (view["extensions"].empty()) view.erase("extensions");
     }
+}
+
+// Reserves size bytes in the meshopt fallback buffer (no data; its views start at 0, as
+// gltfpack's do: only a meshopt decoder reads them); returns the offset.
+static size_t reserve_meshopt_fallback(gltf_doc* doc, size_t size) {
+    size_t offset = doc->meshopt_fallback_bytes;
+    doc->meshopt_fallback_bytes = (offset + size + 3) & ~size_t(3);
+    return offset;
+}
+
+extern "C" void gltf_plan_output(gltf_doc* doc, int binary) { doc->output_binary = binary != 0; }
+
+// The bytes `item` adds to the JSON when it joins the array `key` of the root object, written as
+// gltf_write_file writes it (compact in a GLB, indented in a .gltf).
+static size_t json_growth(const gltf_doc* doc, const char* key, const ordered_json& item) {
+    ordered_json before = ordered_json::object(), after;
+    before[key] = ordered_json::array({ordered_json::object({{"byteLength", 1}})});
+    after = before;
+    after[key].push_back(item);
+    int indent = doc->output_binary ? -1 : 2;
+    return after.dump(indent).size() - before.dump(indent).size();
+}
+
+// The JSON bytes that compressing one more view adds: its extension object, and with the first
+// one the fallback buffer and the extension's names in the lists.
+static size_t meshopt_json_bytes(const gltf_doc* doc, const char* name, const ordered_json& meshopt) {
+    ordered_json view = ordered_json::object({{"byteLength", 1}}), compressed = view;
+    compressed["extensions"][name] = meshopt;
+    size_t bytes = json_growth(doc, "bufferViews", compressed) - json_growth(doc, "bufferViews", view);
+    if (doc->meshopt_fallback_bytes) return bytes;
+    ordered_json buffer = ordered_json::object({{"byteLength", 1}});
+    buffer["extensions"][name]["fallback"] = true;
+    bytes += json_growth(doc, "buffers", buffer);
+    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+        const ordered_json* names = member(doc->json, list);
+        if (!names || !names->is_array() || std::find(names->begin(), names->end(), ordered_json(name)) == names->end())
+            bytes += json_growth(doc, list, name);
+    }
+    return bytes;
+}
+
+// The bytes `size` bytes of binary data take in the output: as they are in a GLB, base64 in a .gltf.
+static size_t stored_size(const gltf_doc* doc, size_t size) { return doc->output_binary ? size : (size + 2) / 3 * 4; }
+
+// Points bufferView JSON `view` at count elements of stride bytes stored meshopt-compressed: the
+// encoded bytes in the new data, the view in the meshopt fallback buffer. false (nothing placed)
+// when the codec does not apply, or when the encoded bytes plus the JSON they need are not
+// smaller than the bytes themselves.
+static bool place_meshopt_view(gltf_doc* doc, ordered_json& view, const void* data, size_t count, size_t stride,
+                               int flags) {
+    std::vector<unsigned char> encoded;
+    if (!gltf_meshopt_encode_attributes(data, count, stride, &encoded)) return false;
+    const char* name = gltf_meshopt_extension_for(doc);
+    ordered_json meshopt = ordered_json::object(); // gltfpack's member order
+    meshopt["buffer"] = GLTF_PENDING_DATA_BUFFER;
+    meshopt["byteOffset"] = doc->added.size();
+    meshopt["byteLength"] = encoded.size();
+    meshopt["byteStride"] = stride;
+    meshopt["mode"] = "ATTRIBUTES";
+    meshopt["count"] = count;
+    if (stored_size(doc, encoded.size()) + meshopt_json_bytes(doc, name, meshopt) >= stored_size(doc, count * stride))
+        return false;
+    meshopt["byteOffset"] = reserve(doc, encoded.data(), encoded.size());
+    view["buffer"] = GLTF_PENDING_MESHOPT_FALLBACK_BUFFER;
+    view["byteOffset"] = reserve_meshopt_fallback(doc, count * stride);
+    view["byteLength"] = count * stride;
+    if (flags & GLTF_ACCESSOR_VERTEX_ATTRIBUTE) view["target"] = 34962; // ARRAY_BUFFER
+    view["extensions"][name] = meshopt;
+    // The fallback buffer has no data: a reader must decode, never read the placeholder.
+    declare(doc, "extensionsUsed", name, true);
+    declare(doc, "extensionsRequired", name, true);
+    return true;
 }
 
 static void set_bounds(ordered_json& accessor, const void* data, size_t count, int component_type, int components) {
@@ -347,7 +419,9 @@ extern "C" int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, 
     ordered_json& views = gltf_json_array(doc, "bufferViews");
     ordered_json& accessors = gltf_json_array(doc, "accessors");
     ordered_json view = ordered_json::object();
-    place_view(doc, view, data, count * size_t(components) * gltf_component_size(component_type), flags);
+    size_t element = size_t(components) * gltf_component_size(component_type);
+    if (!(flags & GLTF_ACCESSOR_MESHOPT) || !place_meshopt_view(doc, view, data, count, element, flags))
+        place_view(doc, view, data, count * element, flags);
     views.push_back(view);
     ordered_json accessor = ordered_json::object();
     accessor["bufferView"] = views.size() - 1;
@@ -356,6 +430,16 @@ extern "C" int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, 
     accessors.push_back(accessor);
     doc->edited = true;
     return int(accessors.size() - 1);
+}
+
+extern "C" size_t gltf_stored_view_bytes(const gltf_doc* doc, int accessor) {
+    const ordered_json* accessors = member(doc->json, "accessors");
+    const ordered_json* views = member(doc->json, "bufferViews");
+    if (!accessors || !views || accessor < 0 || size_t(accessor) >= accessors->size()) return 0;
+    const ordered_json* index = member((*accessors)[size_t(accessor)], "bufferView");
+    if (!index || !index->is_number_unsigned() || index->get<size_t>() >= views->size()) return 0;
+    ordered_json view = (*views)[index->get<size_t>()]; // byte_range_of needs a mutable view
+    return json_size(*byte_range_of(view), "byteLength");
 }
 
 // The bufferView that only accessor `accessor_index` uses (so its bytes may go), or -1.
@@ -438,27 +522,39 @@ extern "C" void gltf_remove_skin_attributes(gltf_doc* doc, size_t mesh, size_t p
     doc->edited = true;
 }
 
-static void declare(gltf_doc* doc, const char* list_name, bool present) {
+// Adds or removes extension `name` in doc->json[list_name] ("extensionsUsed", "extensionsRequired").
+static void declare(gltf_doc* doc, const char* list_name, const char* name, bool present) {
     auto list = doc->json.find(list_name);
     bool listed = false;
     if (list != doc->json.end() && list->is_array())
-        listed = std::find(list->begin(), list->end(), ordered_json(GLTF_EXTENSION_NAME)) != list->end();
+        listed = std::find(list->begin(), list->end(), ordered_json(name)) != list->end();
     if (present == listed) return;
     doc->edited = true;
     if (present) {
-        gltf_json_array(doc, list_name).push_back(GLTF_EXTENSION_NAME);
+        gltf_json_array(doc, list_name).push_back(name);
         return;
     }
-    list->erase(std::find(list->begin(), list->end(), ordered_json(GLTF_EXTENSION_NAME)));
+    list->erase(std::find(list->begin(), list->end(), ordered_json(name)));
     if (list->empty()) doc->json.erase(list_name);
 }
 
 extern "C" void gltf_declare_extension(gltf_doc* doc, int used, int required) {
-    declare(doc, "extensionsUsed", used != 0);
-    declare(doc, "extensionsRequired", required != 0);
+    declare(doc, "extensionsUsed", GLTF_EXTENSION_NAME, used != 0);
+    declare(doc, "extensionsRequired", GLTF_EXTENSION_NAME, required != 0);
 }
 
 // ---- removing what nothing uses ----
+
+// A meshopt extension whose last compressed view skinpack removed leaves the extension lists.
+static void undeclare_if_unused(gltf_doc* doc, const char* name) {
+    if (const ordered_json* views = member(doc->json, "bufferViews"))
+        for (const ordered_json& view : *views) {
+            const char* used = nullptr;
+            if (gltf_meshopt_of(view, &used) && strcmp(used, name) == 0) return;
+        }
+    declare(doc, "extensionsUsed", name, false);
+    declare(doc, "extensionsRequired", name, false);
+}
 
 // Removes accessors from the end of the array while nothing refers to them and `removable`
 // says they are skinpack's, then their bufferViews the same way (cutting their bytes).
@@ -468,6 +564,7 @@ extern "C" size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, s
     size_t freed = 0;
     ordered_json& accessors = gltf_json_array(doc, "accessors");
     std::vector<size_t> candidate_views;
+    std::vector<std::string> meshopt_names; // of the removed views (compress --meshopt)
     bool removed_accessors = false, removed_views = false;
     while (!accessors.empty()) {
         int last = int(accessors.size() - 1);
@@ -486,12 +583,18 @@ extern "C" size_t gltf_remove_unused_tail(gltf_doc* doc, const int* removable, s
             break;
         const ordered_json* buffer = member(views.back(), "buffer");
         if (buffer && buffer->is_number_integer() && buffer->get<int>() == GLTF_PENDING_FALLBACK_BUFFER) break;
+        const char* meshopt = nullptr;
+        if (gltf_meshopt_of(views.back(), &meshopt) && std::find(meshopt_names.begin(), meshopt_names.end(),
+                                                                  std::string(meshopt)) == meshopt_names.end())
+            meshopt_names.push_back(meshopt);
+        if (buffer && buffer->is_number_unsigned()) doc->released_buffers.push_back(buffer->get<size_t>());
         freed += cut_view_bytes(doc, last);
         views.erase(views.end() - 1);
         removed_views = true;
     }
     if (removed_accessors && accessors.empty()) doc->json.erase("accessors");
     if (removed_views && views.empty()) doc->json.erase("bufferViews");
+    for (const std::string& name : meshopt_names) undeclare_if_unused(doc, name.c_str());
     return freed;
 }
 
@@ -588,7 +691,32 @@ static void convert_buffers(const gltf_doc* doc, ordered_json& json, bool binary
     }
 }
 
-// Appends the new data and the fallback buffer, and points the new bufferViews at them.
+// A data-less buffer of `bytes` bytes marked {"fallback": true} in extension `name`, appended to
+// the output's buffers; returns its index (-1 when bytes is 0: none needed).
+static long add_fallback_buffer(ordered_json& json, size_t bytes, const char* name) {
+    if (!bytes) return -1;
+    ordered_json buffer = ordered_json::object();
+    buffer["byteLength"] = bytes;
+    buffer["extensions"][name]["fallback"] = true;
+    json["buffers"].push_back(buffer);
+    return long(json["buffers"].size() - 1);
+}
+
+// A new view (or meshopt range) with a GLTF_PENDING_* buffer gets its real buffer and offset.
+static void resolve_pending(ordered_json& range, long data_buffer, size_t base, long fallback, long meshopt_fallback) {
+    const ordered_json* buffer = member(range, "buffer");
+    if (!buffer || !buffer->is_number_integer()) return;
+    if (buffer->get<int>() == GLTF_PENDING_DATA_BUFFER) {
+        range["buffer"] = data_buffer;
+        range["byteOffset"] = range["byteOffset"].get<size_t>() + base;
+    } else if (buffer->get<int>() == GLTF_PENDING_FALLBACK_BUFFER) {
+        range["buffer"] = fallback;
+    } else if (buffer->get<int>() == GLTF_PENDING_MESHOPT_FALLBACK_BUFFER) {
+        range["buffer"] = meshopt_fallback;
+    }
+}
+
+// Appends the new data and the fallback buffers, and points the new bufferViews at them.
 static void place_new_data(const gltf_doc* doc, ordered_json& json, bool binary, output_buffers* out) {
     long data_buffer = -1;
     size_t base = 0;
@@ -611,24 +739,15 @@ static void place_new_data(const gltf_doc* doc, ordered_json& json, bool binary,
             data_buffer = long(buffers.size() - 1);
         }
     }
-    long fallback = -1;
-    if (doc->fallback_bytes) {
-        ordered_json buffer = ordered_json::object();
-        buffer["byteLength"] = doc->fallback_bytes;
-        buffer["extensions"][GLTF_EXTENSION_NAME]["fallback"] = true;
-        json["buffers"].push_back(buffer);
-        fallback = long(json["buffers"].size() - 1);
-    }
+    // Ours last: when decompress cannot remove the packed views (a file with extensions whose
+    // references are unknown), the meshopt views stay valid and our fallback buffer can still go.
+    long meshopt_fallback = add_fallback_buffer(json, doc->meshopt_fallback_bytes, gltf_meshopt_extension_for(doc));
+    long fallback = add_fallback_buffer(json, doc->fallback_bytes, GLTF_EXTENSION_NAME);
     if (!json.contains("bufferViews")) return;
     for (ordered_json& view : json["bufferViews"]) {
-        const ordered_json* buffer = member(view, "buffer");
-        if (!buffer || !buffer->is_number_integer()) continue;
-        if (buffer->get<int>() == GLTF_PENDING_DATA_BUFFER) {
-            view["buffer"] = data_buffer;
-            view["byteOffset"] = view["byteOffset"].get<size_t>() + base;
-        } else if (buffer->get<int>() == GLTF_PENDING_FALLBACK_BUFFER) {
-            view["buffer"] = fallback;
-        }
+        resolve_pending(view, data_buffer, base, fallback, meshopt_fallback);
+        ordered_json* compressed = byte_range_of(view); // the view itself unless meshopt-compressed
+        if (compressed != &view) resolve_pending(*compressed, data_buffer, base, fallback, meshopt_fallback);
     }
 }
 
@@ -642,7 +761,9 @@ static void drop_unused_buffers(const gltf_doc* doc, ordered_json& json) {
         size_t last = buffers.size() - 1;
         auto cut = doc->cut_data.find(last);
         bool emptied = cut != doc->cut_data.end() && cut->second.empty();
-        if (!emptied && !is_our_fallback(doc, last)) break;
+        bool released = std::find(doc->released_buffers.begin(), doc->released_buffers.end(), last) !=
+                            doc->released_buffers.end() && !buffers[last].contains("uri") && !(doc->binary && last == 0);
+        if (!emptied && !released && !is_our_fallback(doc, last)) break;
         std::vector<std::pair<size_t, size_t>> used;
         used_ranges(doc, int(last), SIZE_MAX, &used);
         if (!used.empty()) break;

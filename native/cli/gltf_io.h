@@ -133,15 +133,28 @@ int gltf_read_accessor_u32(const gltf_doc* doc, int accessor, int component_type
 
 #define GLTF_ACCESSOR_VERTEX_ATTRIBUTE 1 /* bufferView target ARRAY_BUFFER */
 #define GLTF_ACCESSOR_BOUNDS 2           /* write min/max computed from the data */
+#define GLTF_ACCESSOR_MESHOPT 4          /* gltf_add_accessor only: meshopt-compress the view if smaller */
 
 /*
  * Appends an accessor over a new, 4-byte-aligned bufferView holding count elements of
  * components components each (tightly packed, little-endian), appended to the file's binary
  * data. flags: GLTF_ACCESSOR_*. data NULL puts the view in the fallback buffer (a buffer with
  * no data, marked {"fallback": true} in the extension). Returns the accessor index.
+ *
+ * GLTF_ACCESSOR_MESHOPT: when an element is a multiple of 4 bytes and meshoptimizer's vertex
+ * codec makes the bytes smaller, only the encoded bytes are appended; the view itself lies in a
+ * data-less meshopt fallback buffer and carries EXT_meshopt_compression (ATTRIBUTES mode;
+ * KHR_meshopt_compression when the input uses that), which becomes used and required.
  */
 int gltf_add_accessor(gltf_doc* doc, const void* data, size_t count, int component_type, int components,
                       int normalized, int flags);
+/* The kind of file doc will be written as (1: .glb); GLTF_ACCESSOR_MESHOPT weighs the JSON and
+ * base64 sizes of that kind. Default: the input's kind. */
+void gltf_plan_output(gltf_doc* doc, int binary);
+/* 1 if this build can write meshopt-compressed views (libmeshoptimizer, vertex codec version 0). */
+int gltf_meshopt_supported(void);
+/* Bytes an accessor's view occupies in the file: its meshopt-compressed length, or byteLength. */
+size_t gltf_stored_view_bytes(const gltf_doc* doc, int accessor);
 
 /*
  * Gives an existing accessor new data (its index, name, extras and extensions stay). When only

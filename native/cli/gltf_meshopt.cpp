@@ -1,7 +1,8 @@
-// gltf_meshopt.cpp - decoding EXT_meshopt_compression / KHR_meshopt_compression bufferViews
-// (gltfpack -c/-cc, glTF-Transform meshopt) with libmeshoptimizer, so that skinpack can read the
-// attributes of an optimised file. Only tinygltf's model is filled; the file keeps its compressed
-// bytes as they are.
+// gltf_meshopt.cpp - EXT_meshopt_compression / KHR_meshopt_compression with libmeshoptimizer:
+// decoding every compressed bufferView of an input (gltfpack -c/-cc, glTF-Transform meshopt), so
+// that skinpack can read the attributes of an optimised file (only tinygltf's model is filled;
+// the file keeps its compressed bytes as they are), and encoding the views skinpack writes with
+// compress --meshopt (gltf_edit.cpp places them).
 #include "gltf_doc.hpp"
 
 #include <cstring>
@@ -14,7 +15,38 @@
 
 static const char* const MESHOPT_NAMES[] = {"EXT_meshopt_compression", "KHR_meshopt_compression"};
 
-static const ordered_json* meshopt_of(const ordered_json& view, const char** name) {
+const char* gltf_meshopt_extension_for(const gltf_doc* doc) {
+    auto used = doc->json.find("extensionsUsed");
+    if (used != doc->json.end() && used->is_array())
+        for (const ordered_json& name : *used)
+            if (name == MESHOPT_NAMES[1]) return MESHOPT_NAMES[1]; // the input's gltfpack -ce khr convention
+    return MESHOPT_NAMES[0];
+}
+
+bool gltf_meshopt_encode_attributes(const void* data, size_t count, size_t stride, std::vector<unsigned char>* out) {
+#ifdef SKINPACK_HAVE_MESHOPT
+    // The header byte of the vertex codec's version 0, the only one EXT_meshopt_compression allows
+    // (KHR_meshopt_compression also allows 0xa1, but version 0 is valid for both).
+    const unsigned char VERTEX_CODEC_V0 = 0xa0;
+    // ATTRIBUTES mode: byteStride a multiple of 4, at most 256 (EXT_meshopt_compression).
+    if (!data || count == 0 || stride == 0 || stride % 4 || stride > 256) return false;
+    out->resize(meshopt_encodeVertexBufferBound(count, stride));
+    size_t size = meshopt_encodeVertexBuffer(out->data(), out->size(), data, count, stride);
+    out->resize(size);
+    return size > 0 && (*out)[0] == VERTEX_CODEC_V0; // a newer library's default version: not written
+#else
+    (void)data, (void)count, (void)stride, (void)out;
+    return false;
+#endif
+}
+
+extern "C" int gltf_meshopt_supported(void) {
+    static const uint32_t probe[4] = {1, 2, 3, 4};
+    std::vector<unsigned char> encoded;
+    return gltf_meshopt_encode_attributes(probe, 4, 4, &encoded);
+}
+
+const ordered_json* gltf_meshopt_of(const ordered_json& view, const char** name) {
     auto extensions = view.find("extensions");
     if (extensions == view.end() || !extensions->is_object()) return nullptr;
     for (const char* candidate : MESHOPT_NAMES) {
@@ -45,9 +77,13 @@ static int decode_view(const ordered_json& ext, const unsigned char* source, siz
     else if (mode == "TRIANGLES") rc = meshopt_decodeIndexBuffer(dest, count, stride, source, source_size);
     else if (mode == "INDICES") rc = meshopt_decodeIndexSequence(dest, count, stride, source, source_size);
     else return fail(err, err_size, "bufferView %zu: %s mode \"%s\" is not known", view, name, mode.c_str());
+    if (rc == -1) // the header byte: not this mode's data, or a codec version newer than the library
+        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error -1: not %s data, "
+                    "or a newer encoding than libmeshoptimizer %d supports)", view, name, mode.c_str(),
+                    MESHOPTIMIZER_VERSION);
     if (rc != 0)
-        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error %d; a newer "
-                    "encoding than libmeshoptimizer %d supports?)", view, name, rc, MESHOPTIMIZER_VERSION);
+        return fail(err, err_size, "bufferView %zu: %s data does not decode (meshoptimizer error %d: truncated or "
+                    "corrupt)", view, name, rc);
     if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(dest, count, stride);
     else if (filter == "QUATERNION") meshopt_decodeFilterQuat(dest, count, stride);
     else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(dest, count, stride);
@@ -63,7 +99,7 @@ int gltf_decode_meshopt(gltf_doc* doc, char* err, size_t err_size) {
     if (views == doc->json.end() || !views->is_array()) return 0;
     for (size_t v = 0; v < views->size() && v < doc->model.bufferViews.size(); ++v) {
         const char* name = nullptr;
-        const ordered_json* ext = meshopt_of((*views)[v], &name);
+        const ordered_json* ext = gltf_meshopt_of((*views)[v], &name);
         if (!ext) continue;
 #ifndef SKINPACK_HAVE_MESHOPT
         (void)doc;

@@ -193,6 +193,7 @@ static gltf_doc* load(const unsigned char* bytes, size_t size, const std::string
     }
     gltf_doc* doc = new gltf_doc();
     doc->binary = memcmp(bytes, "glTF", 4) == 0;
+    doc->output_binary = doc->binary;
     doc->path = path;
     doc->dir = base_dir;
     if (parse_json(doc, bytes, size, err, err_size) || check_required_extensions(doc, err, err_size) ||

@@ -6,20 +6,23 @@
 Every variant is produced and measured in this run (docs/benchmarks-gltf.md):
   original         the input: Blender's default export (tests/assets/export_blend_assets.py) or
                    the file as shipped (Fox.glb)
-  gltfpack 1.3     gltfpack -cc (npm gltfpack 1.3: quantisation + EXT_meshopt_compression)
+  gltfpack 1.3     gltfpack -cc (npm gltfpack 1.3: quantisation + EXT_meshopt_compression), and
+                   gltfpack -noq -cc (no quantisation: float weights)
   Draco            gltf-transform draco (glTF-Transform 4.5, its default Draco settings)
-  skinpack         skinpack compress --compact (default budget: 32 bits a vertex, OSS)
-  gltfpack+sp      gltfpack -cc, then skinpack compress --compact
+  skinpack         skinpack compress --compact (default budget: 32 bits a vertex, OSS), and with
+                   --meshopt (packed words and tuple table meshopt-compressed where that pays)
+  gltfpack+sp      gltfpack -cc, then skinpack compress --compact, without and with --meshopt;
+                   gltfpack -noq -cc, then skinpack compress --compact --meshopt
 For each: bytes, bytes after gzip -9 and zstd -19 of the whole file, the skin's GPU-resident
 bits a vertex (JOINTS_n + WEIGHTS_n as their accessors decode, or packed words + tuple table;
 from skinpack info on the file, or on its decoded copy for Draco), and the max weight error
-against the original's weights. A last line per asset measures what meshopt-compressing
-skinpack's packed words would save (npm meshoptimizer's encodeVertexBuffer on them).
+against the original's weights. A second table gives, for the --meshopt rows, the bytes of the
+packed words + tuple table and what they take in the file (compress --json).
 
 Errors: skinpack is decoded with skinpack decompress and compared vertex by vertex (exact).
 gltfpack and Draco merge and reorder vertices, so each of their vertices is compared with the
 nearest original vertex (in weights): a lower bound (marked "≥"). gltfpack+sp is skinpack's exact
-error against the gltfpack weights plus that lower bound (marked "≈").
+error against the gltfpack file's weights plus that lower bound (marked "≈").
 """
 import argparse
 import json
@@ -96,35 +99,87 @@ def node_tool(args, script, *paths):
     run([args.node, os.path.join(args.tools, script)] + list(paths))
 
 
-def packed_words_meshopt(args, path):
-    """(raw bytes, meshopt-encoded bytes) of the packed words of every primitive of path."""
-    script = os.path.join(args.work, "words_meshopt.mjs")
-    with open(script, "w") as f:
-        f.write(WORDS_MESHOPT % json.dumps(os.path.join(os.path.abspath(args.tools), "node_modules", "meshoptimizer",
-                                                        "index.js")))
-    return json.loads(run([args.node, script, path]))
+class Asset:
+    """One asset's rows, all measured in this run."""
+
+    def __init__(self, args, asset, rows):
+        self.args, self.asset, self.rows = args, asset, rows
+        self.name = os.path.splitext(os.path.basename(asset))[0]
+        self.reference = skin_influences(asset)
+
+    def path(self, tag):
+        return os.path.join(self.args.work, "%s.%s.glb" % (self.name, tag))
+
+    def add(self, label, path, bits_path, error, error_kind="", report=None):
+        size, z, zs = compressed_sizes(path)
+        bits, _ = stored_bits(self.args.skinpack, bits_path)
+        row = {"asset": self.name, "variant": label, "bytes": size, "gzip": z, "zstd": zs,
+               "gpu_bits_per_vertex": bits, "max_weight_error": error, "error_kind": error_kind}
+        if report:  # skinpack compress --json: the packed words + tuple table, as the GPU holds them and as stored
+            unique = [p for p in report["primitives"] if p["shared_with"] < 0]
+            row["packed_bytes"] = sum(p["packed_bytes"] for p in unique)
+            row["stored_packed_bytes"] = sum(p["stored_packed_bytes"] for p in unique)
+        self.rows.append(row)
+
+    def gltfpack(self, label, tag, flags):
+        """gltfpack with flags; returns (file, its plain decode, its error lower bound)."""
+        out = self.path(tag)
+        run(gltfpack_command(self.args) + ["-i", self.asset, "-o", out] + flags)
+        node_tool(self.args, "meshopt_unpack.mjs", out, out + ".plain.glb")
+        error = error_nearest(self.reference, skin_influences(out + ".plain.glb"))
+        self.add(label, out, out, error, "≥")
+        return out, error
+
+    def skinpack(self, label, source, tag, flags, source_error=None):
+        """skinpack compress --compact flags on source; the error is exact against the original, or
+        (source_error given: a gltfpack file) against source's weights plus source_error."""
+        out = self.path(tag)
+        report = json.loads(run([self.args.skinpack, "compress", source, "-o", out, "--compact", "--json"] + flags))
+        run([self.args.skinpack, "decompress", out, "-o", out + ".decoded.glb"])
+        if source_error is None:
+            error = error_same_order(self.reference, skin_influences(out + ".decoded.glb"))
+            self.add(label, out, out, error, report=report)
+            return
+        node_tool(self.args, "meshopt_unpack.mjs", out + ".decoded.glb", out + ".decoded.plain.glb")
+        on_top = error_same_order(skin_influences(source + ".plain.glb"), skin_influences(out + ".decoded.plain.glb"))
+        self.add(label, out, out, on_top + source_error, "≈", report=report)
 
 
-WORDS_MESHOPT = """
-import { readFileSync } from 'node:fs';
-const { MeshoptEncoder } = await import(%s);
-await MeshoptEncoder.ready;
-const file = readFileSync(process.argv[2]);
-const n = file.readUInt32LE(12), json = JSON.parse(file.subarray(20, 20 + n));
-const bin = file.subarray(20 + n + 8);
-const seen = new Set();
-let raw = 0, encoded = 0;
-for (const mesh of json.meshes) for (const p of mesh.primitives) {
-  const e = p.extensions && p.extensions.SKINPACK_packed_skin;
-  if (!e || seen.has(e.vertices)) continue;
-  seen.add(e.vertices);
-  const a = json.accessors[e.vertices], v = json.bufferViews[a.bufferView];
-  const words = bin.subarray(v.byteOffset || 0, (v.byteOffset || 0) + v.byteLength);
-  raw += v.byteLength;
-  encoded += MeshoptEncoder.encodeVertexBuffer(new Uint8Array(words), a.count, v.byteLength / a.count).length;
-}
-console.log(JSON.stringify([raw, encoded]));
-"""
+def gltfpack_command(args):
+    return [args.node, os.path.join(args.tools, "node_modules", "gltfpack", "cli.js")]
+
+
+def measure(args, asset, rows):
+    a = Asset(args, asset, rows)
+    transform = [args.node, os.path.join(args.tools, "node_modules", "@gltf-transform", "cli", "bin", "cli.js")]
+    a.add("original", asset, asset, 0.0)
+    gltfpack, gp_error = a.gltfpack("gltfpack 1.3 -cc", "gltfpack", ["-cc"])
+    noq, noq_error = a.gltfpack("gltfpack 1.3 -noq -cc", "gltfpack_noq", ["-noq", "-cc"])
+    run(transform + ["draco", asset, a.path("draco")])
+    node_tool(args, "gltf_plain.mjs", a.path("draco"), a.path("draco.plain"))
+    a.add("Draco (glTF-Transform)", a.path("draco"), a.path("draco.plain"),
+          error_nearest(a.reference, skin_influences(a.path("draco.plain"))), "≥")
+    a.skinpack("skinpack", asset, "skinpack", [])
+    a.skinpack("skinpack --meshopt", asset, "skinpack_meshopt", ["--meshopt"])
+    a.skinpack("gltfpack -cc, then skinpack", gltfpack, "gltfpack_sp", [], gp_error)
+    a.skinpack("gltfpack -cc, then skinpack --meshopt", gltfpack, "gltfpack_sp_meshopt", ["--meshopt"], gp_error)
+    a.skinpack("gltfpack -noq -cc, then skinpack --meshopt", noq, "gltfpack_noq_sp_meshopt", ["--meshopt"], noq_error)
+
+
+def print_tables(rows):
+    print("| asset | variant | bytes | gzip -9 | zstd -19 | GPU skin bits/vertex | max weight error |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for r in rows:
+        error = "%s%.2e" % (r["error_kind"], r["max_weight_error"]) if r["max_weight_error"] else "0"
+        print("| %s | %s | %d | %d | %d | %.1f | %s |" % (r["asset"], r["variant"], r["bytes"], r["gzip"], r["zstd"],
+                                                        r["gpu_bits_per_vertex"], error))
+    print()
+    print("| asset | variant | packed words + tuple table | stored with --meshopt | saved |")
+    print("|---|---|---:|---:|---:|")
+    for r in rows:
+        if r["variant"].endswith("--meshopt"):
+            print("| %s | %s | %d | %d | %d |" % (r["asset"], r["variant"], r["packed_bytes"], r["stored_packed_bytes"],
+                                                r["packed_bytes"] - r["stored_packed_bytes"]))
 
 
 def main():
@@ -137,57 +192,10 @@ def main():
     parser.add_argument("assets", nargs="+")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
-    sp = args.skinpack
-    gltfpack = [args.node, os.path.join(args.tools, "node_modules", "gltfpack", "cli.js")]
-    transform = [args.node, os.path.join(args.tools, "node_modules", "@gltf-transform", "cli", "bin", "cli.js")]
     rows = []
     for asset in args.assets:
-        name = os.path.splitext(os.path.basename(asset))[0]
-        w = lambda tag: os.path.join(args.work, "%s.%s.glb" % (name, tag))  # noqa: E731
-        reference = skin_influences(asset)
-
-        def add(label, path, bits_path, error, error_kind=""):
-            size, z, zs = compressed_sizes(path)
-            bits, _ = stored_bits(sp, bits_path)
-            rows.append({"asset": name, "variant": label, "bytes": size, "gzip": z, "zstd": zs,
-                         "gpu_bits_per_vertex": bits, "max_weight_error": error, "error_kind": error_kind})
-
-        add("original", asset, asset, 0.0)
-        run(gltfpack + ["-i", asset, "-o", w("gltfpack"), "-cc"])
-        node_tool(args, "meshopt_unpack.mjs", w("gltfpack"), w("gltfpack.plain"))
-        gp_error = error_nearest(reference, skin_influences(w("gltfpack.plain")))
-        add("gltfpack 1.3 -cc", w("gltfpack"), w("gltfpack"), gp_error, "≥")
-        run(transform + ["draco", asset, w("draco")])
-        node_tool(args, "gltf_plain.mjs", w("draco"), w("draco.plain"))
-        add("Draco (glTF-Transform)", w("draco"), w("draco.plain"),
-            error_nearest(reference, skin_influences(w("draco.plain"))), "≥")
-        run([sp, "compress", asset, "-o", w("skinpack"), "--compact"])
-        run([sp, "decompress", w("skinpack"), "-o", w("skinpack.decoded")])
-        add("skinpack", w("skinpack"), w("skinpack"), error_same_order(reference, skin_influences(w("skinpack.decoded"))))
-        run([sp, "compress", w("gltfpack"), "-o", w("gltfpack_sp"), "--compact"])
-        run([sp, "decompress", w("gltfpack_sp"), "-o", w("gltfpack_sp.decoded")])
-        node_tool(args, "meshopt_unpack.mjs", w("gltfpack_sp.decoded"), w("gltfpack_sp.decoded.plain"))
-        on_top = error_same_order(skin_influences(w("gltfpack.plain")), skin_influences(w("gltfpack_sp.decoded.plain")))
-        add("gltfpack -cc, then skinpack", w("gltfpack_sp"), w("gltfpack_sp"), on_top + gp_error, "≈")
-        raw, encoded = packed_words_meshopt(args, w("gltfpack_sp"))
-        rows[-1]["packed_words_bytes"], rows[-1]["packed_words_meshopt_bytes"] = raw, encoded
-
-    print("| asset | variant | bytes | gzip -9 | zstd -19 | GPU skin bits/vertex | max weight error |")
-    print("|---|---|---:|---:|---:|---:|---:|")
-    for r in rows:
-        error = "%s%.2e" % (r["error_kind"], r["max_weight_error"]) if r["max_weight_error"] else "0"
-        print("| %s | %s | %d | %d | %d | %.1f | %s |" % (r["asset"], r["variant"], r["bytes"], r["gzip"], r["zstd"],
-                                                        r["gpu_bits_per_vertex"], error))
-    print()
-    print("| asset | packed words (gltfpack+sp) | meshopt-encoded | saved | gltfpack+sp with it | gltfpack alone |")
-    print("|---|---:|---:|---:|---:|---:|")
-    by = {(r["asset"], r["variant"]): r for r in rows}
-    for r in rows:
-        if "packed_words_bytes" not in r:
-            continue
-        saved = r["packed_words_bytes"] - r["packed_words_meshopt_bytes"]
-        print("| %s | %d | %d | %d | %d | %d |" % (r["asset"], r["packed_words_bytes"], r["packed_words_meshopt_bytes"],
-                                                   saved, r["bytes"] - saved, by[(r["asset"], "gltfpack 1.3 -cc")]["bytes"]))
+        measure(args, asset, rows)
+    print_tables(rows)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -5,7 +5,8 @@ decoded weights. Copies broken in one way each (a code outside the simplex, a jo
 in two slots, a wrong vertex count, integers a reader must not truncate, a skin smaller than
 jointCount, primitives sharing the packed words with other properties, broken meshlets) must
 stop the import with a message naming the file, mesh, primitive and the library's reason, and
-leave the scene without a new object, mesh or armature.
+leave the scene without a new object, mesh or armature. Files of skinpack compress --meshopt
+(with --cli) are refused naming EXT_meshopt_compression, which Blender's importer cannot decode.
 """
 
 import json
@@ -107,6 +108,33 @@ def expect_refusal(path, *fragments):
     print("refused: %s" % [line for line in message.splitlines() if "ImportRefused" in line][-1].strip())
 
 
+def meshopt_refused(args):
+    """skinpack compress --meshopt files (words in a required EXT_meshopt_compression view, whose
+    fallback buffer has no data): Blender's importer has no meshopt decoder and must refuse them
+    naming the extension, creating nothing, never read the data-less words."""
+    if not args.cli:
+        print("no --cli: the --meshopt refusal is not checked")
+        return
+    import subprocess
+    fox = os.path.join(args.shared, "assets", "Fox.glb")
+    for mode in ("compact", "fallback"):
+        path = os.path.join(args.out, "Fox_%s_meshopt.glb" % mode)
+        subprocess.run([args.cli, "compress", fox, "-o", path, "--" + mode, "--meshopt"], check=True,
+                       capture_output=True)
+        common.check("EXT_meshopt_compression" in common.Glb(path).json["extensionsRequired"], path)
+        before = data_counts()
+        try:
+            bpy.ops.import_scene.gltf(filepath=path)
+        except BaseException as error:
+            message = str(error)
+        else:
+            raise AssertionError("%s imported; Blender cannot decode its EXT_meshopt_compression words" % path)
+        common.check("EXT_meshopt_compression" in message, "%s: message does not name the extension: %s"
+                     % (path, message))
+        common.check(data_counts() == before, "%s: the failed import created data" % path)
+        print("refused: %s: %s" % (os.path.basename(path), message.strip().splitlines()[-1]))
+
+
 def vertex_word(glb, vertex):
     words = glb.accessor(glb.extension()["vertices"])[vertex]
     return int(words[0]) | (int(words[1]) << 32 if len(words) > 1 else 0)
@@ -193,6 +221,7 @@ def main():
     cases = corrupt_files(args.out)
     for path, fragments in cases:
         expect_refusal(path, *fragments)
+    meshopt_refused(args)
     # A refusal leaves the importer usable.
     import_valid("compact_any")
     print("%d broken files refused" % len(cases))

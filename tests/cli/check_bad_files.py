@@ -187,6 +187,37 @@ MESHLETS = [
 ]
 
 
+# ---- compress --meshopt files: the packed words' EXT_meshopt_compression data broken ----
+
+def words_meshopt(d):
+    """(index, extension object) of the packed words' bufferView."""
+    index = d["accessors"][ext_of(d)["vertices"]]["bufferView"]
+    return index, d["bufferViews"][index]["extensions"]["EXT_meshopt_compression"]
+
+
+def meshopt_edit(change):
+    def edit(d, b):
+        change(words_meshopt(d)[1], b)
+    return edit
+
+
+def meshopt_cases(d):
+    """(name, expected words, edit): each message must name the words' bufferView."""
+    view = "bufferView %d" % words_meshopt(d)[0]
+    return [
+        ("truncated", view + ": EXT_meshopt_compression data does not decode (meshoptimizer error -3: truncated",
+         meshopt_edit(lambda m, b: m.__setitem__("byteLength", m["byteLength"] - 9))),
+        ("bad-header", view + ": EXT_meshopt_compression data does not decode",
+         meshopt_edit(lambda m, b: b.__setitem__(m.get("byteOffset", 0), 0x55))),
+        ("past-buffer", view + ": EXT_meshopt_compression bytes",
+         meshopt_edit(lambda m, b: m.__setitem__("byteOffset", len(b) - 4))),
+        ("count", view + ": EXT_meshopt_compression count * byteStride exceeds byteLength",
+         meshopt_edit(lambda m, b: m.__setitem__("count", m["count"] + 1))),
+        ("mode", view + ": EXT_meshopt_compression mode",
+         meshopt_edit(lambda m, b: m.__setitem__("mode", "WORDS"))),
+    ]
+
+
 def expect_failure(cmd, words, out, work):
     if out and os.path.exists(out):
         os.remove(out)
@@ -227,9 +258,15 @@ def main():
                    check=True, capture_output=True)
     meshlets_document, meshlets_binary = load(meshlets_path)
 
+    meshopt_path = os.path.join(args.work, "packed_meshopt.glb")
+    subprocess.run([args.skinpack, "compress", args.asset, "-o", meshopt_path, "--compact", "--meshopt"],
+                   check=True, capture_output=True)
+    meshopt_document, meshopt_binary = load(meshopt_path)
+
     cases = [("standard", c, document, binary) for c in STANDARD] + [("packed", c, packed_document, packed_binary)
                                                                       for c in PACKED]
     cases += [("meshlets", c, meshlets_document, meshlets_binary) for c in MESHLETS]
+    cases += [("meshopt", c, meshopt_document, meshopt_binary) for c in meshopt_cases(meshopt_document)]
     for kind, (name, words, edit), doc, data in cases:
         d, b = copy.deepcopy(doc), bytearray(data)
         edit(d, b)

@@ -3,7 +3,7 @@
     python3 check_corpus.py MODE --skinpack BIN --node NODE --validator tools/validate.mjs
                             --work DIR CORPUS_DIR
 
-MODE is info, fallback, compact or meshlets. Every .gltf/.glb under CORPUS_DIR goes through
+MODE is info, fallback, compact, meshlets or meshopt (compact --meshopt). Every .gltf/.glb under CORPUS_DIR goes through
 `skinpack info` (info) or `skinpack compress` (the others) and every compressed output through
 `skinpack decompress`. A file fails the check when a command
 
@@ -127,12 +127,22 @@ def primitive_of(other_doc, doc, mesh, prim):
         return None
 
 
-def without_owned_members(doc, owned, views, lengths):
-    """A copy of doc without the members the extension owns, for comparison."""
+MESHOPT_NAMES = ("EXT_meshopt_compression", "KHR_meshopt_compression")
+
+
+def added_meshopt_names(before, after):
+    """The meshopt extension names compress --meshopt declared that the input did not have."""
+    return {name for key in ("extensionsUsed", "extensionsRequired") for name in after.get(key, []) or []
+            if name in MESHOPT_NAMES and name not in (before.get(key, []) or [])}
+
+
+def without_owned_members(doc, owned, views, lengths, names=()):
+    """A copy of doc without the members the extension owns (and the extension names `names`
+    compress added), for comparison."""
     doc = json.loads(json.dumps(doc))
     for key in ("extensionsUsed", "extensionsRequired"):
         if key in doc:
-            doc[key] = [name for name in doc[key] if name != EXT]
+            doc[key] = [name for name in doc[key] if name != EXT and name not in names]
             if not doc[key]:
                 del doc[key]
     for mesh in doc.get("meshes", []):
@@ -227,8 +237,9 @@ def json_problems(input_path, output_path, via_path=None):
     skip = owned_views((before, via, after), owned)
     lengths = {key: len(before.get(key, [])) if isinstance(before.get(key), list) else 0
                for key in ("accessors", "bufferViews", "buffers")}
-    a = without_owned_members(before, owned, skip, lengths)
-    b = without_owned_members(after, owned, skip, lengths)
+    names = added_meshopt_names(before, via)
+    a = without_owned_members(before, owned, skip, lengths, names)
+    b = without_owned_members(after, owned, skip, lengths, names)
     problems = []
     for key in sorted(set(a) | set(b)):
         if a.get(key) != b.get(key):
@@ -298,7 +309,8 @@ def check_file(args, path):
         if rc is None or rc not in (0, 1):
             problems.append("info: " + (message if rc is None else "exit status %d: %s" % (rc, message[-300:])))
         return problems, written
-    options = {"fallback": ["--fallback"], "compact": ["--compact"], "meshlets": ["--meshlets"]}[args.mode]
+    options = {"fallback": ["--fallback"], "compact": ["--compact"], "meshlets": ["--meshlets"],
+               "meshopt": ["--compact", "--meshopt"]}[args.mode]
     out = output_name(args.work, args.corpus, path, args.mode)
     rc, message = run([args.skinpack, "compress", path, "-o", out] + options)
     problems += ["compress: " + p for p in command_problems(rc, message, out)]
@@ -317,7 +329,7 @@ def check_file(args, path):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("mode", choices=["info", "fallback", "compact", "meshlets"])
+    parser.add_argument("mode", choices=["info", "fallback", "compact", "meshlets", "meshopt"])
     parser.add_argument("--skinpack", required=True)
     parser.add_argument("--node", required=True)
     parser.add_argument("--validator", required=True)

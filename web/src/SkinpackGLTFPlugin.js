@@ -6,7 +6,10 @@
 // as an RGBA16UI texture, and patches the materials' skinning chunks to decode per vertex;
 // codecs outside the 32-bit GPU profile fall back to the CPU path (userData.skinpack says why).
 // 'cpu' decodes into the standard skinIndex/skinWeight attributes. Both modes read fallback and
-// compact files; errors reject the load with a message naming the mesh and primitive.
+// compact files; errors reject the load with a message naming the mesh and primitive. The packed
+// arrays are read through the parser (getDependency), so files of `skinpack compress --meshopt`
+// load once the loader has loader.setMeshoptDecoder(MeshoptDecoder) (three/addons/libs/
+// meshopt_decoder.module.js); without it three.js rejects them.
 
 import {
   BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,

@@ -3,6 +3,7 @@
 // URL parameters (also for scripted screenshots): ?file=URL&decode=gpu|cpu&weights=original&shade=error&time=T
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { SkinpackGLTFPlugin, skinpackData, skinpackMaterial } from '../src/SkinpackGLTFPlugin.js';
 import { SKINPACK_EXTENSION } from '../src/decode.js';
@@ -45,6 +46,7 @@ function setStatus(text, isError = false) {
 
 function loadGltf(buffer) {
   const loader = new GLTFLoader();
+  loader.setMeshoptDecoder(MeshoptDecoder); // gltfpack -cc and skinpack compress --meshopt files
   if (state.weights === 'decoded') loader.register((parser) => new SkinpackGLTFPlugin(parser, { decode: state.decode }));
   return loader.parseAsync(buffer.slice(0), '');
 }
