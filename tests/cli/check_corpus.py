@@ -249,18 +249,11 @@ def json_problems(input_path, output_path, via_path=None):
     for index, (x, y) in enumerate(zip(before_buffers, after_buffers)):
         if isinstance(x, tuple) and x[0] == "file" and not (isinstance(y, tuple) and y == x):
             problems.append("buffer %d refers to %s instead of %s" % (index, y, x))
-    for index in range(min(lengths["bufferViews"], len(after.get("bufferViews", [])))):
-        if index in skip:
-            continue
-        old = view_bytes(before, before_buffers, index)
-        if old is not None and view_bytes(after, after_buffers, index) != old:
-            problems.append("bufferView %d bytes changed" % index)
-    for index in range(min(lengths["accessors"], len(after.get("accessors", [])))):
-        if index in owned:
-            continue
-        old = accessor_bytes(before, before_buffers, index)
-        if old is not None and accessor_bytes(after, after_buffers, index) != old:
-            problems.append("accessor %d data changed" % index)
+    for kind, ours, read in (("bufferViews", skip, view_bytes), ("accessors", owned, accessor_bytes)):
+        for index in range(min(lengths[kind], len(after.get(kind, [])))):
+            old = None if index in ours else read(before, before_buffers, index)
+            if old is not None and read(after, after_buffers, index) != old:
+                problems.append("%s %d: data changed" % (kind, index))
     for key, items in (("images", before.get("images", [])),):
         for index, image in enumerate(items if isinstance(items, list) else []):
             if isinstance(image, dict) and isinstance(image.get("uri"), str) and not image["uri"].startswith("data:"):
