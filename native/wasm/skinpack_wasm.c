@@ -116,6 +116,13 @@ SPW_EXPORT(spw_message) const char* spw_message(spw_call* call)
     return call->message;
 }
 
+/* sp_packed_params_equal of two calls' declared parameters: 1 if primitives that share a
+ * "vertices" accessor may declare both, else 0. */
+SPW_EXPORT(spw_params_equal) uint32_t spw_params_equal(const spw_call* a, const spw_call* b)
+{
+    return (uint32_t)sp_packed_params_equal(&a->primitive.params, &b->primitive.params);
+}
+
 /* Where the last report stopped: its sp_field and index (vertex, table entry, meshlet, axis). */
 SPW_EXPORT(spw_report_field) uint32_t spw_report_field(const spw_call* call)
 {

@@ -13,7 +13,7 @@ import {
   RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
 } from 'three';
 import { compactLayout, extensionParams, isFallbackBuffer, SKINPACK_EXTENSION } from './decode.js';
-import { decode } from './wasm.js';
+import { decode, paramsEqual } from './wasm.js';
 import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
@@ -45,7 +45,8 @@ export class SkinpackGLTFPlugin {
     if (this.decode !== 'gpu' && this.decode !== 'cpu') throw new Error(`SkinpackGLTFPlugin: decode must be 'gpu' or 'cpu', not ${this.decode}`);
   }
 
-  // Primitives sharing the packed words must declare the same properties (spec 1.0, Accessors).
+  // Primitives sharing the packed words must declare the same properties (spec 1.0, Accessors;
+  // the library's sp_packed_params_equal says which are the same).
   beforeRoot() {
     const seen = new Map();
     const meshes = this.parser.json.meshes || [];
@@ -53,12 +54,17 @@ export class SkinpackGLTFPlugin {
       for (let p = 0; p < meshes[m].primitives.length; ++p) {
         const ext = meshes[m].primitives[p].extensions && meshes[m].primitives[p].extensions[SKINPACK_EXTENSION];
         if (!ext) continue;
-        const { meshlets, ...properties } = ext;
-        const key = JSON.stringify(properties, Object.keys(properties).sort());
+        const where = primitiveName(m, meshes[m], p);
+        let params;
+        try {
+          params = extensionParams(ext);
+        } catch (error) {
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: ${error.message}`));
+        }
         const first = seen.get(ext.vertices);
-        if (first && first.key !== key)
-          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${primitiveName(m, meshes[m], p)}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
-        if (!first) seen.set(ext.vertices, { key, where: primitiveName(m, meshes[m], p) });
+        if (first && !paramsEqual(first.params, params))
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
+        if (!first) seen.set(ext.vertices, { params, where });
       }
     }
     return null;

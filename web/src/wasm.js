@@ -204,6 +204,19 @@ export function codecFromParams(params) {
 }
 
 /**
+ * sp_packed_params_equal: whether two primitives' declared parameters are the same (those
+ * sharing a "vertices" accessor must declare the same, meshlets aside).
+ * @param {PackedParams} a  @param {PackedParams} b
+ */
+export function paramsEqual(a, b) {
+  return withCall((first) => withCall((second) => {
+    setParams(first, a);
+    setParams(second, b);
+    return lib.spw_params_equal(first, second) === 1;
+  }));
+}
+
+/**
  * One stored primitive: the parameters and the two accessors' arrays.
  * @typedef {{params: PackedParams, words: Uint32Array, wordsPerVertex: number,
  *   primitiveVertexCount?: number, lut: Uint8Array|Uint16Array, lutComponents: number,
