@@ -29,7 +29,8 @@ for f in "$src"/*.c; do
 done
 
 # The library functions the JS side calls directly; spw_* (skinpack_wasm.c) export themselves.
-exports="malloc free sp_version sp_method_name sp_method_from_name sp_parse_decimal sp_joint_bytes sp_words_per_vertex"
+exports="malloc free sp_version sp_method_name sp_method_from_name sp_field_name sp_parse_decimal sp_joint_bytes
+         sp_words_per_vertex"
 flags=""
 for name in $exports; do flags="$flags -Wl,--export=$name"; done
 

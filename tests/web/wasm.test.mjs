@@ -6,6 +6,7 @@
 //    WebAssembly trap, never a silently decoded skin that breaks the format's invariants);
 //  * the module's memory is reused from call to call.
 import { test } from 'node:test';
+import { readFileSync } from 'node:fs';
 import assert from 'node:assert/strict';
 import { allCases } from './cases.mjs';
 import { readAccessor, readGltf } from './gltf_file.mjs';
@@ -25,9 +26,17 @@ function refusedWith(run, message, label) {
   assert.throws(run, (error) => {
     assert.ok(error instanceof SkinpackDecodeError, `${label}: ${error}`);
     assert.equal(error.message, message, label);
+    assert.equal(error.field, message.split(':')[0], `${label}: field`); // the library's sp_field_name
     return true;
   }, label);
 }
+
+test('the module imports only WASI functions (stubs that throw), and exports its memory', () => {
+  const module = new WebAssembly.Module(readFileSync(new URL('../../web/wasm/skinpack.wasm', import.meta.url)));
+  const imports = WebAssembly.Module.imports(module);
+  assert.ok(imports.every((i) => i.module === 'wasi_snapshot_preview1' && i.kind === 'function'), JSON.stringify(imports));
+  assert.ok(WebAssembly.Module.exports(module).some((e) => e.name === 'memory' && e.kind === 'memory'));
+});
 
 const vectors = readVectors();
 test('every conformance vector decodes to the C values through WebAssembly, or is refused with the library\'s message', { skip: !vectors && 'no docs/extension/conformance' }, () => {

@@ -173,8 +173,7 @@ function refusal(call) {
   const field = lib.spw_report_field(call);
   const index = lib.spw_report_index(call);
   const at = field === FIELD_VERTICES || field === FIELD_TUPLE_TABLE ? index : undefined;
-  const message = cString(lib.spw_message(call));
-  throw new SkinpackDecodeError(message, at, message.split(':')[0]);
+  throw new SkinpackDecodeError(cString(lib.spw_message(call)), at, cString(lib.sp_field_name(field)));
 }
 
 function withCall(run) {
