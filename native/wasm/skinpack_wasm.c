@@ -158,23 +158,23 @@ SPW_EXPORT(spw_codec_max_error) double spw_codec_max_error(const spw_call* call)
 }
 
 /*
- * Lays out a decoded skin (count vertices of K joints and weights, weight order) as
- * `skinpack decompress` writes JOINTS_0/WEIGHTS_0 and three.js reads skinIndex/skinWeight:
- * 4 slots a vertex, a slot without weight (or past K) has joint 0 and weight 0; joints in
- * joint_bytes (1: u8, 2: u16) each. joints4: count * 4 * joint_bytes bytes, weights4: count * 4.
+ * Lays out a decoded skin in place as `skinpack decompress` writes JOINTS_0/WEIGHTS_0 and
+ * three.js reads skinIndex/skinWeight: spw_validate wrote count vertices of K joints (u16) and
+ * weights (weight order) at the start of joints and weights, which hold count * 4 entries;
+ * afterwards every vertex has 4 slots, a slot without weight (or past K) joint 0 and weight 0,
+ * and with joint_bytes 1 the joints are u8 (count * 4 bytes at the start of joints).
+ * Backwards, so no K-wide entry is overwritten before it is read; the u8 narrowing forwards.
  */
-SPW_EXPORT(spw_expand)
-void spw_expand(const uint16_t* joints, const float* weights, size_t count, uint32_t k, uint32_t joint_bytes,
-                void* joints4, float* weights4)
+SPW_EXPORT(spw_expand) void spw_expand(uint16_t* joints, float* weights, size_t count, uint32_t k, uint32_t joint_bytes)
 {
-    uint8_t* narrow = (uint8_t*)joints4;
-    uint16_t* wide = (uint16_t*)joints4;
-    for (size_t v = 0; v < count; ++v)
-        for (uint32_t s = 0; s < 4; ++s) {
+    for (size_t v = count; v-- > 0;)
+        for (uint32_t s = 4; s-- > 0;) {
             float w = s < k ? weights[v * k + s] : 0.0f;
-            uint16_t j = s < k && w > 0 ? joints[v * k + s] : 0;
-            weights4[v * 4 + s] = w;
-            if (joint_bytes == 1) narrow[v * 4 + s] = (uint8_t)j;
-            else wide[v * 4 + s] = j;
+            joints[v * 4 + s] = s < k && w > 0 ? joints[v * k + s] : 0;
+            weights[v * 4 + s] = w;
         }
+    if (joint_bytes == 1) {
+        uint8_t* narrow = (uint8_t*)joints;
+        for (size_t i = 0; i < count * 4; ++i) narrow[i] = (uint8_t)joints[i]; /* the caller asks for u8 only when jointCount <= 256 */
+    }
 }

@@ -272,16 +272,16 @@ export function decode(primitive, options = {}) {
   return withCall((call, arena) => {
     setParams(call, primitive.params);
     const vertexCount = setArrays(call, arena, primitive);
-    const k = Number(primitive.params.influences);
-    const slots = k >= 1 && k <= 4 ? vertexCount * k : 0; // other K: refused before anything is written
-    const jointsAt = arena.alloc(slots * 2), weightsAt = arena.alloc(slots * 4);
+    // Room for 4 slots a vertex; the library writes K (K > 4 is refused before anything is written).
+    const jointsAt = arena.alloc(vertexCount * 8), weightsAt = arena.alloc(vertexCount * 16);
     if (lib.spw_validate(call, jointsAt, weightsAt) !== 0) refusal(call);
     const codec = reportedCodec(call, arena, primitive.params);
     const width = options.jointBytes ?? jointBytes(codec.jointCount);
-    const joints4 = arena.alloc(vertexCount * 4 * width), weights4 = arena.alloc(vertexCount * 16);
-    lib.spw_expand(jointsAt, weightsAt, vertexCount, k, width, joints4, weights4);
+    if (width !== 2 && !(width === 1 && jointBytes(codec.jointCount) === 1))
+      throw new RangeError(`skinpack-web: jointBytes ${width} cannot hold the joints of jointCount ${codec.jointCount}`);
+    lib.spw_expand(jointsAt, weightsAt, vertexCount, codec.influences, width);
     const Joints = width === 1 ? Uint8Array : Uint16Array;
-    return { codec, joints: heap(Joints, joints4, vertexCount * 4).slice(), weights: heap(Float32Array, weights4, vertexCount * 4).slice(), vertexCount };
+    return { codec, joints: heap(Joints, jointsAt, vertexCount * 4).slice(), weights: heap(Float32Array, weightsAt, vertexCount * 4).slice(), vertexCount };
   });
 }
 
