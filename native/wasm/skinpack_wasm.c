@@ -175,6 +175,7 @@ SPW_EXPORT(spw_expand) void spw_expand(uint16_t* joints, float* weights, size_t 
         }
     if (joint_bytes == 1) {
         uint8_t* narrow = (uint8_t*)joints;
-        for (size_t i = 0; i < count * 4; ++i) narrow[i] = (uint8_t)joints[i]; /* the caller asks for u8 only when jointCount <= 256 */
+        /* the caller asks for u8 only when jointCount <= 256, so every joint fits */
+        for (size_t i = 0; i < count * 4; ++i) narrow[i] = (uint8_t)joints[i];
     }
 }

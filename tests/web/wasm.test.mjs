@@ -39,7 +39,8 @@ test('the module imports only WASI functions (stubs that throw), and exports its
 });
 
 const vectors = readVectors();
-test('every conformance vector decodes to the C values through WebAssembly, or is refused with the library\'s message', { skip: !vectors && 'no docs/extension/conformance' }, () => {
+const CONFORMANCE_TEST = 'every conformance vector decodes to the C values through WebAssembly, or is refused with the library\'s message';
+test(CONFORMANCE_TEST, { skip: !vectors && 'no docs/extension/conformance' }, () => {
   let valid = 0, invalid = 0;
   for (const { vector, ext, code } of vectors) {
     const label = `${vector.method} K=${vector.influences} n=${vector.n} code ${vector.code}`;

@@ -281,7 +281,8 @@ export function decode(primitive, options = {}) {
       throw new RangeError(`skinpack-web: jointBytes ${width} cannot hold the joints of jointCount ${codec.jointCount}`);
     lib.spw_expand(jointsAt, weightsAt, vertexCount, codec.influences, width);
     const Joints = width === 1 ? Uint8Array : Uint16Array;
-    return { codec, joints: heap(Joints, jointsAt, vertexCount * 4).slice(), weights: heap(Float32Array, weightsAt, vertexCount * 4).slice(), vertexCount };
+    const joints = heap(Joints, jointsAt, vertexCount * 4).slice(), weights = heap(Float32Array, weightsAt, vertexCount * 4).slice();
+    return { codec, joints, weights, vertexCount };
   });
 }
 
