@@ -12,7 +12,8 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 # Debian packages the build, the tests and the benchmarks need.
 PACKAGES=(cmake make gcc g++ clang libclang-rt-14-dev python3-numpy blender libtinygltf-dev
           glslang-tools mesa-vulkan-drivers libvulkan-dev vulkan-tools libmeshoptimizer-dev
-          gltfpack zlib1g-dev libzstd-dev zstd chromium nlohmann-json3-dev)
+          gltfpack zlib1g-dev libzstd-dev zstd chromium nlohmann-json3-dev
+          lld wasi-libc libclang-rt-14-dev-wasm32)
 
 install_packages() {
   local missing=()

@@ -212,15 +212,15 @@ function brokenVariant(name, edit) {
 
 const extOf = (json) => json.meshes[0].primitives[0].extensions[SKINPACK_EXTENSION];
 const BROKEN = {
-  weightBits: [(json) => { extOf(json).weightBits += 1; }, /"weightBits"/],
-  method: [(json) => { extOf(json).method = 'zip'; }, /unknown "method"/],
-  jointCount: [(json) => { extOf(json).jointCount = json.skins[0].joints.length + 1; }, /"jointCount"/],
-  tableType: [(json) => { json.accessors[extOf(json).tupleTable].componentType = 5123; }, /"tupleTable" accessor/],
-  wordCount: [(json) => { json.accessors[extOf(json).vertices].count -= 1; }, /entries for \d+ vertices/],
+  weightBits: [(json) => { extOf(json).weightBits += 1; }, /: weightBits: \d+ contradicts the other parameters or the data \(expected \d+\)$/],
+  method: [(json) => { extOf(json).method = 'zip'; }, /: method: unknown method$/],
+  jointCount: [(json) => { extOf(json).jointCount = json.skins[0].joints.length + 1; }, /: jointCount: \d+ contradicts the other parameters or the data \(expected \d+\)$/],
+  tableType: [(json) => { json.accessors[extOf(json).tupleTable].componentType = 5123; }, /: (tupleTable: 2 contradicts|"tupleTable" accessor \d+ ends at byte)/],
+  wordCount: [(json) => { json.accessors[extOf(json).vertices].count -= 1; }, /: vertices: \d+ packed vertices, the primitive has \d+$/],
   word: [(json, bin) => {
     const view = json.bufferViews[json.accessors[extOf(json).vertices].bufferView];
     new DataView(bin.buffer, bin.byteOffset).setUint32((view.byteOffset || 0) + 7 * 4, 0xffffffff, true);
-  }, /vertex 7: /],
+  }, /: vertices: .* at vertex 7$/],
   sharedWords: [(json) => {
     const primitive = json.meshes[0].primitives[0];
     const copy = JSON.parse(JSON.stringify(primitive));
@@ -232,7 +232,7 @@ const BROKEN = {
   tableEntry: [(json, bin) => {
     const accessor = json.accessors[extOf(json).tupleTable];
     bin[(json.bufferViews[accessor.bufferView].byteOffset || 0) + 1] = extOf(json).jointCount;
-  }, /tuple table entry 0 has joint/],
+  }, /: tupleTable: joint \d+ not below jointCount \d+ at tuple 0$/],
 };
 
 for (const [name, [edit, pattern, where = 'mesh 0 "fox1" primitive 0']] of Object.entries(BROKEN)) {

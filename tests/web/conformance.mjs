@@ -1,5 +1,6 @@
 // conformance.mjs - the spec's conformance vectors (docs/extension/conformance/weights.jsonl)
-// as decode.js codecs, shared by the CPU test and the WebGL2 read-back.
+// with the codecs the library (WebAssembly, through decode.js) builds from their parameters,
+// shared by the WebAssembly test and the WebGL2 read-back.
 import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { codecFromExtension } from '../../web/src/decode.js';
@@ -14,7 +15,7 @@ function jsonInteger(text) {
   return value <= 2n ** 53n ? Number(value) : text;
 }
 
-/** Every vector with its codec (or the error building it) and its code as the codec wants it. */
+/** Every vector with its extension parameters, its codec and its code (a BigInt). */
 export function readVectors() {
   if (!existsSync(VECTORS)) return null;
   return readFileSync(VECTORS, 'utf8').split('\n').filter(Boolean).map((line) => {
@@ -23,7 +24,7 @@ export function readVectors() {
       n: jsonInteger(vector.n), weightBits: vector.weightBits, tupleBits: 0 };
     if (vector.method === 'any' && vector.influences > 1) ext.axisSamples = vector.axisSamples.map(jsonInteger);
     const codec = codecFromExtension(ext);
-    return { vector, ext, codec, code: codec.number ? Number(vector.code) : BigInt(vector.code) };
+    return { vector, ext, codec, code: BigInt(vector.code) };
   });
 }
 

@@ -88,7 +88,7 @@ test('a broken file is shown as an error naming mesh and primitive', async () =>
   writeGlb(broken, json, buffers[0]);
   await open(broken);
   assert.ok(await page.locator('#status.error').isVisible(), 'no error status');
-  assert.match(await text('#status'), /mesh 0 "fox1" primitive 0: "tupleBits"/);
+  assert.match(await text('#status'), /mesh 0 "fox1" primitive 0: tupleBits: /);
 });
 
 test('a file opened with the Open button decodes too', async () => {

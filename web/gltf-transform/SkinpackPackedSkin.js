@@ -16,7 +16,8 @@
 // so a loader without the extension refuses them; the reader gives such views zero bytes.
 
 import { Extension, ExtensionProperty, PropertyType } from '@gltf-transform/core';
-import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, jointBytes, SKINPACK_EXTENSION } from '../src/decode.js';
+import { compactLayout, extensionParams, isFallbackBuffer, jointBytes, SKINPACK_EXTENSION } from '../src/decode.js';
+import { validate } from '../src/wasm.js';
 
 export const WORDS_ATTRIBUTE = '_SKINPACK_WORDS';
 const PARAMETERS = ['influences', 'jointCount', 'method', 'n', 'axisSamples', 'weightBits', 'tupleBits', 'maxError'];
@@ -144,16 +145,13 @@ export class SkinpackPackedSkin extends Extension {
   }
 }
 
-// The write refuses what would decode wrongly: word count off the vertex count, bad data.
+// The write refuses what would decode wrongly (word count off the vertex count, bad data): the
+// library validates the primitive as a reader will find it.
 function checkDecodes(def, primitive, words, table, where) {
   const position = primitive.getAttribute('POSITION');
-  if (position && position.getCount() !== words.getCount())
-    throw new Error(`${where}: ${words.getCount()} packed words for ${position.getCount()} vertices`);
   try {
-    const codec = codecFromExtension(def);
-    if (words.getElementSize() !== codec.wordsPerVertex || !(words.getArray() instanceof Uint32Array))
-      throw new Error(`the packed words are no longer ${codec.wordsPerVertex} UNSIGNED_INT a vertex`);
-    decodeSkin(codec, words.getArray(), table.getArray());
+    validate({ params: extensionParams(def), words: words.getArray(), wordsPerVertex: words.getElementSize(),
+      primitiveVertexCount: position ? position.getCount() : undefined, lut: table.getArray(), lutComponents: table.getElementSize() });
   } catch (error) {
     throw new Error(`${where}: ${error.message}`);
   }

@@ -15,11 +15,13 @@ import {
   BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,
   RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
 } from 'three';
-import { codecFromExtension, compactLayout, decodeSkin, isFallbackBuffer, jointBytes, SKINPACK_EXTENSION } from './decode.js';
+import { compactLayout, extensionParams, isFallbackBuffer, SKINPACK_EXTENSION } from './decode.js';
+import { decode, paramsEqual } from './wasm.js';
 import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
 const TABLE_TYPES = ['SCALAR', 'VEC2', 'VEC3', 'VEC4'];
+const components = (type) => TABLE_TYPES.indexOf(type) + 1;
 
 // Per geometry: the codec, the packed arrays, the decoded skin and (fallback files) the original
 // attributes. Kept out of userData, which three.js clones through JSON.
@@ -46,7 +48,8 @@ export class SkinpackGLTFPlugin {
     if (this.decode !== 'gpu' && this.decode !== 'cpu') throw new Error(`SkinpackGLTFPlugin: decode must be 'gpu' or 'cpu', not ${this.decode}`);
   }
 
-  // Primitives sharing the packed words must declare the same properties (spec 1.0, Accessors).
+  // Primitives sharing the packed words must declare the same properties (spec 1.0, Accessors;
+  // the library's sp_packed_params_equal says which are the same).
   beforeRoot() {
     const seen = new Map();
     const meshes = this.parser.json.meshes || [];
@@ -54,12 +57,17 @@ export class SkinpackGLTFPlugin {
       for (let p = 0; p < meshes[m].primitives.length; ++p) {
         const ext = meshes[m].primitives[p].extensions && meshes[m].primitives[p].extensions[SKINPACK_EXTENSION];
         if (!ext) continue;
-        const { meshlets, ...properties } = ext;
-        const key = JSON.stringify(properties, Object.keys(properties).sort());
+        const where = primitiveName(m, meshes[m], p);
+        let params;
+        try {
+          params = extensionParams(ext);
+        } catch (error) {
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: ${error.message}`));
+        }
         const first = seen.get(ext.vertices);
-        if (first && first.key !== key)
-          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${primitiveName(m, meshes[m], p)}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
-        if (!first) seen.set(ext.vertices, { key, where: primitiveName(m, meshes[m], p) });
+        if (first && !paramsEqual(first.params, params))
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
+        if (!first) seen.set(ext.vertices, { params, where });
       }
     }
     return null;
@@ -90,29 +98,29 @@ export class SkinpackGLTFPlugin {
     });
   }
 
-  // Reads and checks the extension's accessors and decodes every vertex (the check of the words
-  // is the decode; the GPU path keeps the words and uses the decoded values only on the CPU).
+  // Reads the extension's accessors (the glTF side: types, ranges in their buffers) and hands
+  // them to the library, which checks every format rule and decodes every vertex. Both paths
+  // need that: the GPU path's shader assumes valid data, and its bounding volumes and raycasts
+  // skin on the CPU from the decoded values.
   async _decodePrimitive(meshIndex, primitive, ext, where) {
     const json = this.parser.json;
-    const codec = codecFromExtension(ext);
-    this._checkJointCount(meshIndex, codec);
+    const params = extensionParams(ext);
     const wordsDef = json.accessors[ext.vertices], tableDef = json.accessors[ext.tupleTable];
     if (!wordsDef) throw new Error(`"vertices" = ${ext.vertices} is not an accessor`);
     if (!tableDef) throw new Error(`"tupleTable" = ${ext.tupleTable} is not an accessor`);
-    const wordType = codec.wordsPerVertex === 1 ? 'SCALAR' : 'VEC2';
-    if (wordsDef.componentType !== COMPONENT_UNSIGNED_INT || wordsDef.type !== wordType)
-      throw new Error(`"vertices" accessor ${ext.vertices} must be UNSIGNED_INT ${wordType} for ${codec.tupleBits + codec.weightBits} bits`);
-    const tableComponent = jointBytes(codec.jointCount) === 1 ? COMPONENT_UNSIGNED_BYTE : COMPONENT_UNSIGNED_SHORT;
-    if (tableDef.componentType !== tableComponent || tableDef.type !== TABLE_TYPES[codec.influences - 1])
-      throw new Error(`"tupleTable" accessor ${ext.tupleTable} must be ${tableComponent === COMPONENT_UNSIGNED_BYTE ? 'UNSIGNED_BYTE' : 'UNSIGNED_SHORT'} ${TABLE_TYPES[codec.influences - 1]}`);
+    if (wordsDef.componentType !== COMPONENT_UNSIGNED_INT || !['SCALAR', 'VEC2'].includes(wordsDef.type))
+      throw new Error(`"vertices" accessor ${ext.vertices} must be UNSIGNED_INT SCALAR or VEC2`);
+    if (![COMPONENT_UNSIGNED_BYTE, COMPONENT_UNSIGNED_SHORT].includes(tableDef.componentType) || !TABLE_TYPES.includes(tableDef.type))
+      throw new Error(`"tupleTable" accessor ${ext.tupleTable} must be UNSIGNED_BYTE or UNSIGNED_SHORT, SCALAR to VEC4`);
     for (const [field, accessor] of [['vertices', wordsDef], ['tupleTable', tableDef]]) this._checkAccessor(field, ext[field], accessor);
     const position = json.accessors[primitive.attributes.POSITION];
-    if (!position || position.count !== wordsDef.count)
-      throw new Error(`"vertices" has ${wordsDef.count} entries for ${position ? position.count : 0} vertices`);
     const [wordsAttribute, tableAttribute] = await Promise.all([
       this.parser.getDependency('accessor', ext.vertices), this.parser.getDependency('accessor', ext.tupleTable)]);
     const words = wordsAttribute.array, lut = tableAttribute.array;
-    const decoded = decodeSkin(codec, words, lut);
+    const { codec, ...decoded } = decode({
+      params, words, wordsPerVertex: components(wordsDef.type), primitiveVertexCount: position ? position.count : undefined,
+      lut, lutComponents: components(tableDef.type), skinJointCount: this._skinJointCount(meshIndex),
+    });
     return { codec, words, lut, decoded, compact: compactLayout(json, primitive) !== null };
   }
 
@@ -125,7 +133,7 @@ export class SkinpackGLTFPlugin {
     const view = json.bufferViews[accessor.bufferView];
     if (!view) throw new Error(`${name}: bufferView ${accessor.bufferView} does not exist`);
     const componentBytes = { [COMPONENT_UNSIGNED_BYTE]: 1, [COMPONENT_UNSIGNED_SHORT]: 2, [COMPONENT_UNSIGNED_INT]: 4 }[accessor.componentType];
-    const size = componentBytes * (TABLE_TYPES.indexOf(accessor.type) + 1); // types were checked above
+    const size = componentBytes * components(accessor.type); // types were checked above
     if (view.byteStride && view.byteStride !== size) throw new Error(`${name} must be tightly packed (byteStride ${view.byteStride})`);
     const end = (accessor.byteOffset || 0) + accessor.count * size;
     if (end > view.byteLength) throw new Error(`${name} ends at byte ${end}, past its bufferView's ${view.byteLength}`);
@@ -134,13 +142,17 @@ export class SkinpackGLTFPlugin {
       throw new Error(`${name}: bufferView ${accessor.bufferView} lies outside its buffer`);
   }
 
-  _checkJointCount(meshIndex, codec) {
+  // Joints of the smallest skin of the nodes that use the mesh (0: none), which the declared
+  // jointCount must not exceed.
+  _skinJointCount(meshIndex) {
     const json = this.parser.json;
+    let smallest = 0;
     for (const node of json.nodes || []) {
       if (node.mesh !== meshIndex || node.skin === undefined) continue;
       const joints = json.skins[node.skin].joints.length;
-      if (codec.jointCount > joints) throw new Error(`"jointCount" = ${codec.jointCount} exceeds the ${joints} joints of skin ${node.skin}`);
+      if (!smallest || joints < smallest) smallest = joints;
     }
+    return smallest;
   }
 
   _attach(mesh, packed, where) {
@@ -161,10 +173,9 @@ export class SkinpackGLTFPlugin {
       skinIndex: geometry.getAttribute('skinIndex'), skinWeight: geometry.getAttribute('skinWeight') } });
     if (refusal) {
       if (this.decode === 'gpu') console.warn(`SkinpackGLTFPlugin: ${where}: CPU decode: ${refusal}`);
-      const joints = jointBytes(codec.jointCount) === 1 ? Uint8Array.from(decoded.joints) : decoded.joints; // as glTF stores them
-      geometry.setAttribute('skinIndex', new BufferAttribute(joints, 4));
+      geometry.setAttribute('skinIndex', new BufferAttribute(decoded.joints, 4)); // u8 or u16, as glTF stores them
       geometry.setAttribute('skinWeight', new BufferAttribute(decoded.weights, 4));
-      info.gpuSkinBytes = joints.byteLength + decoded.weights.byteLength;
+      info.gpuSkinBytes = decoded.joints.byteLength + decoded.weights.byteLength;
       return;
     }
     attachGpuSkin(mesh, packed);
