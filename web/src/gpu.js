@@ -90,6 +90,7 @@ export function codecDefines(codec, rowWidth = TUPLE_TEXTURE_WIDTH) {
       defines.LAYER_TOP = floatLiteral(Number(8n * m ** 3n + 12n * m * m - 106n - 144n * codec.maxCode));
       defines.LAYER_APEX = floatLiteral((2 * codec.n + 3) / 4);
     }
+
   }
   if (k > 1 && codec.method === 'any') codec.axisNumbers.forEach((q, a) => { defines[`AXIS${a + 2}`] = uintLiteral(q); });
   if (k > 1 && ['fixed', 'cube', 'pot'].includes(codec.method)) defines['UNPACK_GRID(code, q)'] = gridUnpackMacro(codec);
@@ -109,21 +110,22 @@ uniform highp vec4 skinpackDivisors; // grid: s in x; any: i (q_i - 1) in y, z, 
 highp uint skinpackRowBase(highp uint b, highp uint j) {
   return (j * (4u * b + 2u - 3u * j) + 1u) >> 2;
 }
-// The largest row j with sb(j) <= rest, and sb(j). One square root (the Paper's mirrored root,
-// 12 (S(b) - rest) + 4 ((b^2 + b + 1) mod 3) = 4 (b^2 + b + 1 - 3 rest): exact integers, no
-// division), then comparisons: right or one off for 32-bit values, and the loops end on the
-// exact row whatever the estimate. A valid rest is below sb(last + 1) = S(b), which ends the
-// upward loop at the last row; the downward one ends at sb(0) = 0.
+// The largest row j with sb(j) <= rest, and sb(j). The estimate is codec_oss_simd.h's
+// row_estimate: the mirrored square root for rest + 7/8, (2b + 1 - sqrt(4 (b^2 + b + 1 -
+// 3 rest) - 10.5)) / 3 from an exact integer difference. rest + 7/8 lies strictly between the
+// unfloored form at j and j + 1, so in exact arithmetic the estimate is in (j, j + 1); float
+// error is far below one row (the root is below 2^17 and GLSL ES's highp sqrt is a few ulp), so
+// its floor is j - 1, j or j + 1 and one comparison each way makes it exact. No loops or
+// fallback branches: SwiftShader runs both sides of every branch and keeps loop variables in
+// memory, which costs more than the estimate. For a valid rest (files are validated on load)
+// sb(last + 1) = S(b) > rest, so the estimate's largest value, last + 1, comes down.
 highp uint skinpackRow(highp uint b, highp uint rest, out highp uint base) {
-  highp float root = sqrt(float(b * b + b + 1u - 3u * rest));
-  highp float estimate = (float(2u * b + 1u) - 2.0 * root) * (1.0 / 3.0);
-  highp uint row = estimate > 0.0 ? uint(estimate) : 0u; // NaN lands on 0
+  highp float root = sqrt(4.0 * float(b * b + b + 1u - 3u * rest) - 10.5);
+  highp float estimate = (float(2u * b + 1u) - root) * (1.0 / 3.0);
+  highp uint row = estimate > 0.0 ? uint(estimate) : 0u; // at most last + 1; NaN lands on 0
+  row -= uint(skinpackRowBase(b, row) > rest);           // sb(0) = 0 <= rest
+  row += uint(skinpackRowBase(b, row + 1u) <= rest);
   base = skinpackRowBase(b, row);
-  while (base > rest) base = skinpackRowBase(b, --row);
-  for (highp uint next = skinpackRowBase(b, row + 1u); next <= rest; next = skinpackRowBase(b, row + 1u)) {
-    ++row;
-    base = next;
-  }
   return row;
 }
 #endif
@@ -135,16 +137,19 @@ highp uint skinpackLayerNumerator(highp uint k) {
   return 3u * SKINPACK_N * k * (SKINPACK_N + 3u - 2u * k) + k * (4u * k * k + 6u - 9u * k) + 2u;
 }
 // The largest layer k with u(k) <= code, and u(k): sp_oss_layer_narrow's one cube root
-// (t = c + 1/c, c = cbrt(x), x = 144 (max code - code) + x(max code): every code strictly inside
-// its layer, no square roots), then one comparison each way; the loops end on the exact layer.
+// (t = c + 1/c, c = cbrt(x), x = 144 (max code - code) + x(max code), for code + 17/18, which
+// lies strictly inside its layer, codec_oss_simd.h), no square roots. Float error (c < 2^13, a
+// few ulp through pow and the reciprocal) moves the floor by at most one layer, so one
+// comparison each way makes it exact, as for the row.
 highp uint skinpackLayer(highp uint code, out highp uint base) {
   highp float c = pow(144.0 * float(SKINPACK_MAX_CODE - code) + SKINPACK_LAYER_TOP, 1.0 / 3.0);
   highp float estimate = SKINPACK_LAYER_APEX - 0.25 * (c + 1.0 / c);
   highp uint layer = estimate > 0.0 ? min(uint(estimate), SKINPACK_LAST_LAYER) : 0u; // NaN lands on 0
   highp uint bound = 9u * code + 8u;
-  while (layer > 0u && skinpackLayerNumerator(layer) > bound) --layer;
-  while (layer < SKINPACK_LAST_LAYER && skinpackLayerNumerator(layer + 1u) <= bound) ++layer;
-  base = skinpackLayerNumerator(layer) / 9u;
+  layer -= uint(skinpackLayerNumerator(layer) > bound); // 9 u(0) + 2 = 2 <= bound
+  layer += uint(layer < SKINPACK_LAST_LAYER) & uint(skinpackLayerNumerator(layer + 1u) <= bound);
+  highp uint numerator = skinpackLayerNumerator(layer);
+  base = numerator / 9u;
   return layer;
 }
 #endif
