@@ -218,6 +218,10 @@ export function codecFromExtension(ext) {
     return field;
   });
   codec.code32 = codec.maxCode < 2n ** 32n;
+  if (method === 'oss' && k === 4) { // x(max code) of findLayerNumber's estimate: at least 6
+    const m = n + 1n;
+    codec.layerTop = Number(8n * m ** 3n + 12n * m * m - 106n - 144n * codec.maxCode);
+  }
   return codec;
 }
 
@@ -233,35 +237,38 @@ function layerBaseNumber(n, k) {
   return Math.floor((3 * n * k * (n - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2) / 9);
 }
 
-// Largest row j with s_N(j) <= w (oss_find_row): mirrored square-root estimate, exact fix-up.
+// Largest row j with s_N(j) <= w (oss_find_row): the mirrored square root for w + 7/8, which
+// lies strictly inside row j's interval of the unfloored form (codec_oss_simd.h's
+// row_estimate), from the exact integer n^2 + n + 1 - 3w; float error moves it by at most a
+// row or so, and the loops make it exact whatever the estimate.
 function findRowNumber(n, w) {
   const rows = Math.floor((2 * n + 1) / 3);
-  const apex = 2 * n + 1;
-  const estimate = (apex - Math.sqrt(apex * apex + 3 - 12 * w)) / 3;
-  let j = estimate <= 0 ? 0 : Math.floor(estimate);
+  const estimate = (2 * n + 1 - Math.sqrt(4 * (n * n + n + 1 - 3 * w) - 10.5)) / 3;
+  let j = estimate > 0 ? Math.floor(estimate) : 0; // NaN lands on 0
   if (j >= rows) j = rows - 1;
   while (j + 1 < rows && rowBaseNumber(n, j + 1) <= w) ++j;
   while (j > 0 && rowBaseNumber(n, j) > w) --j;
   return j;
 }
 
-// Largest layer k with u(k) <= code (oss_find_layer): the paper's cube-root estimate, fixed up.
-function findLayerNumber(n, code) {
-  const layers = Math.floor((n + 1) / 2);
-  const m = n + 1;
-  const v = 4 * m * m * m + 6 * m * m + 16 - 72 * code;
-  const root = v > 2 ? Math.sqrt(v * (v - 2)) : 0;
-  let c = Math.cbrt(v - 1 + root);
-  if (c < 1) c = 1;
-  const estimate = (2 * n + 3 - (c + 1 / c)) / 4;
-  let k = estimate <= 0 ? 0 : Math.floor(estimate);
+// Largest layer k with u(k) <= code (oss_find_layer): one cube root, t = c + 1/c with
+// c = cbrt(x), x = 8 M^3 + 12 M^2 - 106 - 144 code (M = N + 1) for code + 17/18, which lies
+// strictly inside its layer (native/src/codec_oss.c's find_layer_small): no square root.
+// x = 144 (max code - code) + x(max code), the latter a small exact integer (codec.layerTop),
+// so the estimate has no cancellation; the loops make it exact.
+function findLayerNumber(codec, code) {
+  const n = codec.n, layers = Math.floor((n + 1) / 2);
+  const c = Math.cbrt(144 * (codec.maxCodeNumber - code) + codec.layerTop);
+  const estimate = (2 * n + 3) / 4 - (c + 1 / c) / 4;
+  let k = estimate > 0 ? Math.floor(estimate) : 0; // NaN lands on 0
   if (k >= layers) k = layers - 1;
   while (k + 1 < layers && layerBaseNumber(n, k + 1) <= code) ++k;
   while (k > 0 && layerBaseNumber(n, k) > code) --k;
   return k;
 }
 
-function ossUnpackNumber(n, k, code, q) {
+function ossUnpackNumber(codec, code, q) {
+  const n = codec.n, k = codec.influences;
   if (k === 2) {
     q[1] = code;
     q[0] = 2 * (n - 1) - code;
@@ -269,7 +276,7 @@ function ossUnpackNumber(n, k, code, q) {
   }
   let layer = 0, rest = code, bottom = n;
   if (k === 4) {
-    layer = findLayerNumber(n, code);
+    layer = findLayerNumber(codec, code);
     rest -= layerBaseNumber(n, layer);
     bottom = n - 2 * layer;
   }
@@ -412,7 +419,7 @@ export function decodeWeightCode(codec, code, weights, offset = 0, grid = null) 
   }
   const q = GRID;
   q[0] = q[1] = q[2] = q[3] = 0;
-  if (codec.method === 'oss') ossUnpackNumber(codec.n, k, code, q);
+  if (codec.method === 'oss') ossUnpackNumber(codec, code, q);
   else gridUnpackNumber(codec, code, q);
   return gridToWeights(q, k, codec.scaleNumber, weights, offset, grid);
 }
