@@ -116,8 +116,8 @@ highp uint skinpackRowBase(highp uint b, highp uint j) {
 // unfloored form at j and j + 1, so in exact arithmetic the estimate is in (j, j + 1); float
 // error is far below one row (the root is below 2^17 and GLSL ES's highp sqrt is a few ulp), so
 // its floor is j - 1, j or j + 1 and one comparison each way makes it exact. No loops or
-// fallback branches: SwiftShader runs both sides of every branch and keeps loop variables in
-// memory, which costs more than the estimate. For a valid rest (files are validated on load)
+// fallback branches: on SwiftShader they cost more than the estimate, even untaken
+// (docs/benchmarks-web.md); tests/web/gpu_decode.test.mjs checks the bound. For a valid rest (files are validated on load)
 // sb(last + 1) = S(b) > rest, so the estimate's largest value, last + 1, comes down.
 highp uint skinpackRow(highp uint b, highp uint rest, out highp uint base) {
   highp float root = sqrt(4.0 * float(b * b + b + 1u - 3u * rest) - 10.5);
