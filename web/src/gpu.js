@@ -1,7 +1,8 @@
 // gpu.js - the GPU decode path: a GLSL ES 3.00 port of the narrow (32-bit) decoder of
 // shaders/skinpack_decode.glsl specialised per codec (#define constants), the tuple table as an
-// RGBA16UI texture, and the patch of three.js's skinning chunks. WebGL2 has no uaddCarry/umulExtended/bitfieldExtract
-// (GLSL ES 3.10), so only the 32-bit GPU profile decodes here; wider codecs decode on the CPU.
+// RGBA16UI texture, and the patch of three.js's skinning chunks. WebGL2 has no uaddCarry,
+// umulExtended or bitfieldExtract (GLSL ES 3.10), so only the 32-bit GPU profile decodes here;
+// wider codecs decode on the CPU.
 
 import { ShaderChunk, Vector4 } from 'three';
 
@@ -66,9 +67,9 @@ function gridUnpackMacro(codec) {
 }
 
 /**
- * The codec as GLSL #define constants: every parameter the decoder reads is fixed at compile
- * time, so the shader compiler folds the closed forms' constant parts, turns divisions by
- * constants into multiplications and drops the other methods' code.
+ * The codec as GLSL #define constants: every parameter the decoder reads but the weights'
+ * divisors is fixed at compile time, so the shader compiler folds the closed forms' constant
+ * parts and the preprocessor drops the other methods' code.
  * @param {object} codec  decode.js codecFromExtension, inside the GPU profile (gpuProfileRefusal null)
  * @param {number} rowWidth  tuple texture row length, a power of two
  */
