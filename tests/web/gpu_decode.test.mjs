@@ -5,7 +5,8 @@
 // moved by ROOT_ULPS ulp either way (more than GLSL ES 3.00 allows highp pow and sqrt to be off,
 // so a GPU that rounds differently from SwiftShader stays exact; the layers pass with 1000 ulp,
 // the rows with 256) and checks every layer's and every row's first and last
-// code: all of them for every K = 4 codec of the GPU profile, rows for sampled K = 3 codecs.
+// code: all of them for every K = 4 codec of the GPU profile, rows for sampled K = 3 codecs;
+// and the division by 9 without integer division (skinpackDivideBy9).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { codecFromExtension, ossCodeCount, ossLayerBase, ossRowBase } from '../../web/src/decode.js';
@@ -97,4 +98,22 @@ test('row estimates are within one row: every in-layer triangle of K = 4, sample
   for (const n of sampled) worst = Math.max(worst, checkRows(n));
   console.log(`# rows of every b <= ${largest4} and ${sampled.length} N up to ${largest3}: worst miss ${worst} row(s)`);
   assert.ok(worst <= 1, `a row estimate is ${worst} rows off`);
+});
+
+// skinpackDivideBy9 in binary32, the float quotient's guess moved by up to 4 either way (any
+// rounding of the conversion and product).
+function divideBy9(x, shift) {
+  const guess = Math.trunc(f(f(x) * f(1 / 9))) + shift;
+  const remainder = x - 9 * guess; // the shader's x - 9u * guess as int: exact, small
+  return guess + Math.floor(f(f(remainder + 0.5) * f(1 / 9)));
+}
+
+test('the shader\'s division by 9 is exact for every 32-bit value (edges, every residue near 2^32, random)', () => {
+  const values = [0, 1, 8, 9, 10, 2 ** 24 - 1, 2 ** 24, 2 ** 24 + 1, 2 ** 31 - 1, 2 ** 31, 2 ** 32 - 1];
+  for (let x = 2 ** 32 - 4096; x < 2 ** 32; ++x) values.push(x);
+  for (let p = 1; p < 32; ++p) for (let d = -20; d <= 20; ++d) if (2 ** p + d >= 0) values.push(2 ** p + d);
+  let seed = 12345;
+  for (let i = 0; i < 200000; ++i) { seed = (seed * 1103515245 + 12345) % 2 ** 31; values.push(Math.floor((seed / 2 ** 31) * 2 ** 32)); }
+  for (const x of values)
+    for (const shift of [-4, 0, 4]) assert.equal(divideBy9(x, shift), Math.floor(x / 9), `x = ${x}, guess ${shift} off`);
 });

@@ -133,9 +133,18 @@ highp uint skinpackRow(highp uint b, highp uint rest, out highp uint base) {
 
 #if SKINPACK_METHOD == 4 && SKINPACK_K == 4
 // 9 u(k) + (its remainder): u(k) <= code iff this <= 9 code + 8, which stays below 2^32 in the
-// GPU profile (largest code <= (2^32 - 9) / 9), so the search divides only once, at the end.
+// GPU profile (largest code <= (2^32 - 9) / 9), so only the layer's base needs a division.
 highp uint skinpackLayerNumerator(highp uint k) {
   return 3u * SKINPACK_N * k * (SKINPACK_N + 3u - 2u * k) + k * (4u * k * k + 6u - 9u * k) + 2u;
+}
+// floor(x / 9) for any 32-bit x without an integer division (a CPU has no vector integer
+// division: SwiftShader divides lane by lane): a float quotient within about 80 of the result, then the exact
+// remainder's correction, r = x - 9 g (|r| < 2^10, exact in float; (r + 1/2) / 9 is at least
+// 1/18 from an integer, far more than the product's rounding).
+highp uint skinpackDivideBy9(highp uint x) {
+  highp uint guess = uint(float(x) * (1.0 / 9.0));
+  highp float remainder = float(int(x - 9u * guess));
+  return uint(int(guess) + int(floor((remainder + 0.5) * (1.0 / 9.0))));
 }
 // The largest layer k with u(k) <= code, and u(k): sp_oss_layer_narrow's one cube root
 // (t = c + 1/c, c = cbrt(x), x = 144 (max code - code) + x(max code), for code + 17/18, which
@@ -149,8 +158,7 @@ highp uint skinpackLayer(highp uint code, out highp uint base) {
   highp uint bound = 9u * code + 8u;
   layer -= uint(skinpackLayerNumerator(layer) > bound); // 9 u(0) + 2 = 2 <= bound
   layer += uint(layer < SKINPACK_LAST_LAYER) & uint(skinpackLayerNumerator(layer + 1u) <= bound);
-  highp uint numerator = skinpackLayerNumerator(layer);
-  base = numerator / 9u;
+  base = skinpackDivideBy9(skinpackLayerNumerator(layer));
   return layer;
 }
 #endif
