@@ -3,8 +3,9 @@
 //     decoder writes (4 x u16 joints + 4 x f32 weights = 24 bytes a vertex), in node (V8).
 //  2. Rendering in headless chromium on SwiftShader: many animated instances of a real mesh with
 //     the plugin's GPU decode vs the same scene with float skin attributes (plain three.js on
-//     the `skinpack decompress` output), frame times measured in the same page run.
-// Usage: node tests/web/bench.mjs [--instances N] [--frames F] (env as for the tests).
+//     the `skinpack decompress` output), frame times measured in the same page run: RE_Player
+//     and Fox at the default OSS budget and Fox Fixed-coded (the cheapest decode).
+// Usage: node tests/web/bench.mjs [--instances N] [--frames F] [--rounds R] (env as for the tests).
 import { basename } from 'node:path';
 import { allCases, WORK } from './cases.mjs';
 import { readGltf, readAccessor } from './gltf_file.mjs';
@@ -13,7 +14,7 @@ import { codecFromExtension, decodeSkin, SKINPACK_EXTENSION } from '../../web/sr
 
 const args = process.argv.slice(2);
 const option = (name, fallback) => { const i = args.indexOf(name); return i >= 0 ? Number(args[i + 1]) : fallback; };
-const INSTANCES = option('--instances', 64), FRAMES = option('--frames', 40);
+const INSTANCES = option('--instances', 64), FRAMES = option('--frames', 40), ROUNDS = option('--rounds', 3);
 const cases = allCases();
 
 function median(values) { return [...values].sort((a, b) => a - b)[values.length >> 1]; }
@@ -38,7 +39,7 @@ function cpuDecodeBench(c, targetVertices = 2e6) {
     copyTimes.push(performance.now() - start);
   }
   const decode = vertices / (median(decodeTimes) / 1000), copy = vertices / (median(copyTimes) / 1000);
-  return { name: c.name, method: `${ext.method} K=${ext.influences} ${ext.weightBits}+${ext.tupleBits} bits${codec.number ? '' : ' (BigInt)'}`,
+  return { name: c.name, method: `${ext.method} K=${ext.influences} ${ext.weightBits}+${ext.tupleBits} bits`,
            vertices, decode, copy };
 }
 
@@ -51,26 +52,37 @@ console.log('\n| file | codec | vertices | decode (Mvertices/s) | TypedArray.set
 for (const r of rows)
   console.log(`| ${r.name} | ${r.method} | ${r.vertices.toLocaleString('en')} | ${(r.decode / 1e6).toFixed(1)} | ${(r.copy / 1e6).toFixed(0)} | ${(r.decode / r.copy).toFixed(3)} |`);
 
+const SCENES = ['float attributes (decompressed, plain three.js)', 'plugin GPU decode', 'plugin CPU decode'];
+
+// Frame times of the three scenes of one case, ROUNDS interleaved rounds (against the drift of
+// a shared machine); returns the median of each scene's round medians and renderer.info.
+async function renderBench(page, c) {
+  const variants = [[basename(c.decoded), null], [basename(c.packed), 'gpu'], [basename(c.packed), 'cpu']];
+  const results = variants.map(() => []);
+  let info = null;
+  for (let round = 0; round < ROUNDS; ++round)
+    for (let v = 0; v < variants.length; ++v) {
+      const r = await page.page.evaluate(([f, d, n, k]) => window.skinpackTest.benchmark(f, d, n, k), [`/files/${variants[v][0]}`, variants[v][1], INSTANCES, FRAMES]);
+      results[v].push(r.median);
+      info = r.info;
+    }
+  const codec = codecFromExtension(readGltf(c.packed).json.meshes.flatMap((m) => m.primitives)
+    .map((p) => p.extensions && p.extensions[SKINPACK_EXTENSION]).find(Boolean));
+  return { name: c.name, codec: `${codec.method} ${codec.weightBits}+${codec.tupleBits} bits`, info, rounds: results, times: results.map(median) };
+}
+
 const page = await openTestPage(WORK);
+const benches = [];
 try {
-  for (const tag of ['RE_Player_female_fallback', 'Fox_fallback']) {
+  for (const tag of ['RE_Player_female_fallback', 'Fox_fallback', 'Fox_fixed24']) {
     const c = cases.find((x) => x.name === tag);
-    if (!c) continue;
-    const variants = [['float attributes (decompressed, plain three.js)', basename(c.decoded), null],
-                      ['plugin GPU decode', basename(c.packed), 'gpu'], ['plugin CPU decode', basename(c.packed), 'cpu']];
-    const results = variants.map(() => []);
-    let info = null;
-    for (let round = 0; round < 3; ++round) // interleaved rounds against drift of the shared machine
-      for (let v = 0; v < variants.length; ++v) {
-        const r = await page.page.evaluate(([f, d, n, k]) => window.skinpackTest.benchmark(f, d, n, k), [`/files/${variants[v][1]}`, variants[v][2], INSTANCES, FRAMES]);
-        results[v].push(r.median);
-        info = r.info;
-      }
-    const base = median(results[0]);
-    console.log(`\n${tag}: ${INSTANCES} instances, ${info.calls} draws, ${info.triangles.toLocaleString('en')} triangles a frame, 256 x 256, median of ${FRAMES} frames x 3 rounds`);
-    console.log('| scene | frame time (ms) | ratio to float attributes |\n|---|---|---|');
-    variants.forEach((v, i) => console.log(`| ${v[0]} | ${median(results[i]).toFixed(2)} | ${(median(results[i]) / base).toFixed(3)} |`));
+    if (c) benches.push(await renderBench(page, c));
   }
 } finally {
   await page.close();
 }
+console.log(`\n${INSTANCES} instances, 256 x 256, median frame time (ms) of ${FRAMES} frames, median of ${ROUNDS} interleaved rounds`);
+console.log(`| scene | ${benches.map((b) => `${b.name} (${b.codec}; ${b.info.calls} draws, ${b.info.triangles.toLocaleString('en')} triangles) | ratio`).join(' | ')} |`);
+console.log(`|---|${benches.map(() => '---|---|').join('')}`);
+SCENES.forEach((scene, i) => console.log(`| ${scene} | ${benches.map((b) => `${b.times[i].toFixed(1)} | ${(b.times[i] / b.times[0]).toFixed(3)}`).join(' | ')} |`));
+for (const b of benches) console.log(`# ${b.name} rounds (ms): ${SCENES.map((s, i) => b.rounds[i].map((t) => t.toFixed(1)).join('/')).join('  ')}`);

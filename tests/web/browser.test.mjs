@@ -129,8 +129,8 @@ test('the WebGL2 shader decodes every GPU-profile case exactly (integer render t
   let checked = 0;
   for (const c of cases) {
     if (!narrowTags.has(c.name)) continue;
-    // Tuple textures of 7 entries a row: every table spans rows (the plugin uses 2048).
-    const results = await page.page.evaluate((f) => window.skinpackTest.gpuReadback(f, 7), `/files/${basename(c.packed)}`);
+    // Tuple textures of 8 entries a row (a power of two, as the shader requires): every table spans rows (the plugin uses 2048).
+    const results = await page.page.evaluate((f) => window.skinpackTest.gpuReadback(f, 8), `/files/${basename(c.packed)}`);
     for (const r of results) {
       assert.equal(r.jointMismatches, 0, `${c.name} ${r.mesh}: joints differ, first ${JSON.stringify(r.first)}`);
       assert.equal(r.qMismatches, 0, `${c.name} ${r.mesh}: grid integers differ`);

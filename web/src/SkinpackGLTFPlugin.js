@@ -13,11 +13,11 @@
 
 import {
   BufferAttribute, DataTexture, MeshDepthMaterial, MeshDistanceMaterial, NearestFilter, RGBADepthPacking,
-  RGBAIntegerFormat, SkinnedMesh, UnsignedShortType, Vector4,
+  RGBAIntegerFormat, SkinnedMesh, UnsignedShortType,
 } from 'three';
 import { compactLayout, extensionParams, isFallbackBuffer, SKINPACK_EXTENSION } from './decode.js';
 import { decode, paramsEqual } from './wasm.js';
-import { codecProgramKey, codecUniformValues, gpuProfileRefusal, patchSkinningShader, tupleTexels } from './gpu.js';
+import { codecProgramKey, gpuProfileRefusal, gpuSkinUniforms, patchSkinningShader, tupleTexels } from './gpu.js';
 
 const COMPONENT_UNSIGNED_BYTE = 5121, COMPONENT_UNSIGNED_SHORT = 5123, COMPONENT_UNSIGNED_INT = 5125;
 const TABLE_TYPES = ['SCALAR', 'VEC2', 'VEC3', 'VEC4'];
@@ -238,13 +238,7 @@ export function attachGpuSkin(mesh, packed) {
   texture.magFilter = texture.minFilter = NearestFilter;
   texture.generateMipmaps = false;
   texture.needsUpdate = true;
-  const values = codecUniformValues(codec, width);
-  const uniforms = {
-    skinpackTuples: { value: texture },
-    skinpackConfig: { value: new Vector4(...values.config) }, skinpackParams: { value: new Vector4(...values.params) },
-    skinpackBits: { value: new Vector4(...values.bits) }, skinpackAxes: { value: new Vector4(...values.axes) },
-    skinpackFactors: { value: new Vector4(...values.factors) },
-  };
+  const uniforms = gpuSkinUniforms(codec, texture); // the other codec parameters are shader constants
   geometry.deleteAttribute('skinIndex');
   geometry.deleteAttribute('skinWeight');
   geometry.setAttribute('skinpackWord', new BufferAttribute(words, 1));

@@ -1,9 +1,10 @@
 // gpu.js - the GPU decode path: a GLSL ES 3.00 port of the narrow (32-bit) decoder of
-// shaders/skinpack_decode.glsl, its uniforms, the tuple table as an RGBA16UI texture, and the
-// patch of three.js's skinning chunks. WebGL2 has no uaddCarry/umulExtended/bitfieldExtract
-// (GLSL ES 3.10), so only the 32-bit GPU profile decodes here; wider codecs decode on the CPU.
+// shaders/skinpack_decode.glsl specialised per codec (#define constants), the tuple table as an
+// RGBA16UI texture, and the patch of three.js's skinning chunks. WebGL2 has no uaddCarry,
+// umulExtended or bitfieldExtract (GLSL ES 3.10), so only the 32-bit GPU profile decodes here;
+// wider codecs decode on the CPU.
 
-import { ShaderChunk } from 'three';
+import { ShaderChunk, Vector4 } from 'three';
 
 // SP_OSS_NARROW_MAX_CODE_K4 / _K3 of shaders/skinpack_gpu_layout.h: up to these largest codes
 // every intermediate of the OSS closed forms stays below 2^32.
@@ -26,18 +27,10 @@ export function gpuProfileRefusal(codec) {
   return null;
 }
 
-/** Uniform values of one codec (codec from decode.js codecFromExtension). */
-export function codecUniformValues(codec, lutWidth) {
-  const config = [codec.methodId, codec.influences, codec.weightBits, codec.tupleBits];
-  const params = [codec.n >>> 0, Number(codec.scale) >>> 0, codec.maxCodeNumber >>> 0, lutWidth];
-  const bits = [0, 0, 0, 0], axes = [0, 0, 0, 0], factors = [0, 0, 0, 0];
-  codec.componentBits.forEach((b, i) => { bits[i] = b; });
-  if (codec.method === 'any') codec.axisNumbers.forEach((q, a) => { axes[a] = q; factors[a] = (a + 2) * (q - 1); });
-  return { config, params, bits, axes, factors };
-}
-
-/** The tuple table as RGBA16UI texels (one entry a texel, rowWidth entries a row). */
+/** The tuple table as RGBA16UI texels (one entry a texel, rowWidth entries a row). rowWidth is
+ *  a power of two: the shader addresses entry t at (t & (rowWidth - 1), t >> log2(rowWidth)). */
 export function tupleTexels(lut, influences, rowWidth = TUPLE_TEXTURE_WIDTH) {
+  rowBitsOf(rowWidth);
   const entries = lut.length / influences;
   const width = Math.min(entries, rowWidth), height = Math.ceil(entries / width);
   const texels = new Uint16Array(width * height * 4);
@@ -46,147 +39,227 @@ export function tupleTexels(lut, influences, rowWidth = TUPLE_TEXTURE_WIDTH) {
   return { texels, width, height };
 }
 
-// Uniform block and decoder. Method ids are SP_METHOD_* (decode.js METHODS order).
-export const DECODE_GLSL = /* glsl */ `
-uniform highp usampler2D skinpackTuples;
-uniform highp uvec4 skinpackConfig;  // method, K, weight bits, tuple bits
-uniform highp uvec4 skinpackParams;  // n (m or N), grid s, largest code, tuple texture width
-uniform highp uvec4 skinpackBits;    // fixed/cube/pot: bits of each stored weight, code order
-uniform highp uvec4 skinpackAxes;    // any: q2, q3, q4
-uniform highp vec4 skinpackFactors;  // any: i (q_i - 1), the divisor of axis i
+function rowBitsOf(rowWidth) {
+  const bits = Math.log2(rowWidth);
+  if (!Number.isInteger(bits) || bits < 0 || bits > 15) throw new Error(`tuple texture rows of ${rowWidth} entries: not a power of two up to 2^15`);
+  return bits;
+}
 
-// The skinning shaders fix method and K at compile time (one program per codec kind, every
-// other decoder compiled out); the read-back test leaves them to the uniforms.
-#ifndef SKINPACK_METHOD
-#define SKINPACK_METHOD skinpackConfig.x
-#define SKINPACK_K skinpackConfig.y
+// GLSL literals: unsigned integers and binary32 values (the nearest float, as a Float32Array
+// uniform would hold it; every value written is an integer or a multiple of 1/4).
+const uintLiteral = (value) => `${BigInt(value)}u`;
+function floatLiteral(value) {
+  const text = String(Math.fround(value));
+  return /[.e]/.test(text) ? text : `${text}.0`;
+}
+
+// Grid methods: q_slot = (code >> shift) & mask for each stored slot (Fixed stores q1 too).
+function gridUnpackMacro(codec) {
+  const first = codec.method === 'fixed' ? 0 : 1;
+  let shift = 0;
+  const statements = codec.componentBits.map((bits, c) => {
+    const mask = bits >= 32 ? 0xffffffff : 2 ** bits - 1;
+    const statement = `q[${first + c}] = (code >> ${shift}u) & ${uintLiteral(mask)};`;
+    shift += bits;
+    return statement;
+  });
+  return statements.join(' ');
+}
+
+/**
+ * The codec as GLSL #define constants: every parameter the decoder reads but the weights'
+ * divisors is fixed at compile time, so the shader compiler folds the closed forms' constant
+ * parts and the preprocessor drops the other methods' code.
+ * @param {object} codec  decode.js codecFromExtension, inside the GPU profile (gpuProfileRefusal null)
+ * @param {number} rowWidth  tuple texture row length, a power of two
+ */
+export function codecDefines(codec, rowWidth = TUPLE_TEXTURE_WIDTH) {
+  const k = codec.influences, rowBits = rowBitsOf(rowWidth);
+  const defines = {
+    METHOD: codec.methodId, K: k, WEIGHT_BITS: codec.weightBits, // plain integers: the preprocessor tests them
+    CODE_MASK: uintLiteral(codec.weightBits >= 32 ? 0xffffffff : 2 ** codec.weightBits - 1),
+    ROW_BITS: uintLiteral(rowBits), ROW_MASK: uintLiteral(rowWidth - 1), SCALE: uintLiteral(codec.scale),
+  };
+  if (k > 1 && codec.method === 'oss') {
+    defines.N = uintLiteral(codec.n);
+    if (k === 4) {
+      // The layer estimate's x(code) = 144 (max code - code) + x(max code) (sp_oss_layer_narrow),
+      // x(max code) = 8 M^3 + 12 M^2 - 106 - 144 max code with M = N + 1, a small exact integer.
+      const m = BigInt(codec.n) + 1n;
+      defines.MAX_CODE = uintLiteral(codec.maxCode);
+      defines.LAST_LAYER = uintLiteral((codec.n + 1 >> 1) - 1);
+      defines.LAYER_TOP = floatLiteral(Number(8n * m ** 3n + 12n * m * m - 106n - 144n * codec.maxCode));
+      defines.LAYER_APEX = floatLiteral((2 * codec.n + 3) / 4);
+    }
+
+  }
+  if (k > 1 && codec.method === 'any') codec.axisNumbers.forEach((q, a) => { defines[`AXIS${a + 2}`] = uintLiteral(q); });
+  if (k > 1 && ['fixed', 'cube', 'pot'].includes(codec.method)) defines['UNPACK_GRID(code, q)'] = gridUnpackMacro(codec);
+  return Object.entries(defines).map(([name, value]) => `#define SKINPACK_${name} ${value}\n`).join('');
+}
+
+// The decoder (GLSL ES 3.00, after codecDefines). Method ids are SP_METHOD_* (decode.js METHODS
+// order). The files were validated on load (decodeSkin), so the shader only decodes.
+const DECODE_BODY = /* glsl */ `
+uniform highp usampler2D skinpackTuples;
+// Divisors of the weights, a uniform so that the division stays one: a compiler may turn a
+// division by a constant into a multiplication by its reciprocal, which rounds differently.
+uniform highp vec4 skinpackDivisors; // grid: s in x; any: i (q_i - 1) in y, z, w
+
+#if SKINPACK_METHOD == 4 && SKINPACK_K >= 3
+// Row j of a triangle with b bottom samples starts at sb(j) = floor((j (4b + 2 - 3j) + 1) / 4).
+highp uint skinpackRowBase(highp uint b, highp uint j) {
+  return (j * (4u * b + 2u - 3u * j) + 1u) >> 2;
+}
+// The largest row j with sb(j) <= rest, and sb(j). The estimate is codec_oss_simd.h's
+// row_estimate: the mirrored square root for rest + 7/8, (2b + 1 - sqrt(4 (b^2 + b + 1 -
+// 3 rest) - 10.5)) / 3 from an exact integer difference. rest + 7/8 lies strictly between the
+// unfloored form at j and j + 1, so in exact arithmetic the estimate is in (j, j + 1); float
+// error is far below one row (the root is below 2^17 and GLSL ES's highp sqrt is a few ulp), so
+// its floor is j - 1, j or j + 1 and one comparison each way makes it exact. No loops or
+// fallback branches: on SwiftShader they cost more than the estimate, even untaken
+// (docs/benchmarks-web.md); tests/web/gpu_decode.test.mjs checks the bound. For a valid rest (files are validated on load)
+// sb(last + 1) = S(b) > rest, so the estimate's largest value, last + 1, comes down.
+highp uint skinpackRow(highp uint b, highp uint rest, out highp uint base) {
+  highp float root = sqrt(4.0 * float(b * b + b + 1u - 3u * rest) - 10.5);
+  highp float estimate = (float(2u * b + 1u) - root) * (1.0 / 3.0);
+  highp uint row = estimate > 0.0 ? uint(estimate) : 0u; // at most last + 1; NaN lands on 0
+  row -= uint(skinpackRowBase(b, row) > rest);           // sb(0) = 0 <= rest
+  row += uint(skinpackRowBase(b, row + 1u) <= rest);
+  base = skinpackRowBase(b, row);
+  return row;
+}
 #endif
 
-highp uint skinpackRowBase(highp uint n, highp uint j) {
-  return (j * (4u * n + 2u - 3u * j) + 1u) / 4u;
+#if SKINPACK_METHOD == 4 && SKINPACK_K == 4
+// 9 u(k) + (its remainder): u(k) <= code iff this <= 9 code + 8, which stays below 2^32 in the
+// GPU profile (largest code <= (2^32 - 9) / 9), so only the layer's base needs a division.
+highp uint skinpackLayerNumerator(highp uint k) {
+  return 3u * SKINPACK_N * k * (SKINPACK_N + 3u - 2u * k) + k * (4u * k * k + 6u - 9u * k) + 2u;
 }
-highp uint skinpackLayerBase(highp uint n, highp uint k) {
-  return (3u * n * k * (n + 3u - 2u * k) + k * (4u * k * k + 6u - 9u * k) + 2u) / 9u;
+// floor(x / 9) for any 32-bit x without an integer division (a CPU has no vector integer
+// division: SwiftShader divides lane by lane): a float quotient within about 80 of the result, then the exact
+// remainder's correction, r = x - 9 g (|r| < 2^10, exact in float; (r + 1/2) / 9 is at least
+// 1/18 from an integer, far more than the product's rounding).
+highp uint skinpackDivideBy9(highp uint x) {
+  highp uint guess = uint(float(x) * (1.0 / 9.0));
+  highp float remainder = float(int(x - 9u * guess));
+  return uint(int(guess) + int(floor((remainder + 0.5) * (1.0 / 9.0))));
 }
-highp uint skinpackBase(bool layer, highp uint n, highp uint x) {
-  return layer ? skinpackLayerBase(n, x) : skinpackRowBase(n, x);
+// The largest layer k with u(k) <= code, and u(k): sp_oss_layer_narrow's one cube root
+// (t = c + 1/c, c = cbrt(x), x = 144 (max code - code) + x(max code), for code + 17/18, which
+// lies strictly inside its layer, codec_oss_simd.h), no square roots. Float error (c < 2^13, a
+// few ulp through pow and the reciprocal) moves the floor by at most one layer, so one
+// comparison each way makes it exact, as for the row.
+highp uint skinpackLayer(highp uint code, out highp uint base) {
+  highp float c = pow(144.0 * float(SKINPACK_MAX_CODE - code) + SKINPACK_LAYER_TOP, 1.0 / 3.0);
+  highp float estimate = SKINPACK_LAYER_APEX - 0.25 * (c + 1.0 / c);
+  highp uint layer = estimate > 0.0 ? min(uint(estimate), SKINPACK_LAST_LAYER) : 0u; // NaN lands on 0
+  highp uint bound = 9u * code + 8u;
+  layer -= uint(skinpackLayerNumerator(layer) > bound); // 9 u(0) + 2 = 2 <= bound
+  layer += uint(layer < SKINPACK_LAST_LAYER) & uint(skinpackLayerNumerator(layer + 1u) <= bound);
+  base = skinpackDivideBy9(skinpackLayerNumerator(layer));
+  return layer;
 }
-// Largest x in [0, last] with base(x) <= code: gallop from the float estimate, then bisect
-// (sp_oss_search32).
-highp uint skinpackSearch(bool layer, highp uint n, highp uint last, highp float estimate, highp uint code) {
-  highp uint x = estimate >= 0.0 ? uint(min(estimate, float(last))) : 0u;
-  x = min(x, last);
-  highp uint low, high;
-  if (skinpackBase(layer, n, x) <= code) {
-    low = x; high = last + 1u;
-    for (highp uint step = 1u; step <= last - low; step <<= 1) {
-      highp uint probe = low + step;
-      if (skinpackBase(layer, n, probe) > code) { high = probe; break; }
-      low = probe;
-    }
-  } else {
-    high = x; low = 0u;
-    for (highp uint step = 1u; step < high; step <<= 1) {
-      highp uint probe = high - step;
-      if (skinpackBase(layer, n, probe) <= code) { low = probe; break; }
-      high = probe;
-    }
-  }
-  while (high - low > 1u) {
-    highp uint middle = low + (high - low) / 2u;
-    if (skinpackBase(layer, n, middle) <= code) low = middle; else high = middle;
-  }
-  return low;
-}
-highp float skinpackRowEstimate(highp float n, highp float countMinusRest, highp float triangleRemainder) {
-  return (2.0 * n + 1.0 - sqrt(12.0 * countMinusRest + 4.0 * triangleRemainder)) / 3.0;
-}
-highp float skinpackLayerEstimate(highp float n, highp float countMinusCode) {
-  highp float v = 72.0 * countMinusCode + 39.0;
-  highp float c = pow(v - 1.0 + sqrt(v) * sqrt(v - 2.0), 1.0 / 3.0);
-  return (2.0 * n + 3.0 - (c + 1.0 / c)) / 4.0;
-}
-highp uint skinpackLowBits(highp uint value, highp uint bits) {
-  return bits >= 32u ? value : value & ((1u << bits) - 1u);
-}
-// Exact integers q1..q4 (any: x2..x4 in slots 2..4) and the float weights of one code.
+#endif
+
+// Exact integers q1..q4 (Any: x2..x4 in slots 2..4) and the float weights of one code.
 highp vec4 skinpackDecodeWeights(highp uint code, out highp uvec4 q) {
-  highp uint method = SKINPACK_METHOD, k = SKINPACK_K;
   q = uvec4(0u);
-  if (k == 1u) { q.x = 1u; return vec4(1.0, 0.0, 0.0, 0.0); }
-  if (method == 3u) { // any
-    highp vec4 w = vec4(0.0);
-    highp uint rest = code;
-    for (highp uint axis = 0u; axis + 1u < k; ++axis) {
-      highp uint samples = skinpackAxes[axis];
-      q[axis + 1u] = rest % samples;
-      rest /= samples;
-      w[axis + 1u] = float(q[axis + 1u]) / skinpackFactors[axis];
-    }
-    w.x = 1.0 - (w.y + w.z + w.w);
-    return w;
-  }
-  highp uint scale = skinpackParams.y;
-  if (method == 4u) { // oss
-    highp uint n = skinpackParams.x;
-    highp uint layer = 0u, row = 0u, rest = code, bottom = n;
-    if (k == 4u) {
-      highp float estimate = skinpackLayerEstimate(float(n), float(skinpackParams.z - code) + 1.0);
-      layer = skinpackSearch(true, n, (n + 1u) / 2u - 1u, estimate, code);
-      rest -= skinpackLayerBase(n, layer);
-      bottom = n - 2u * layer;
-    }
-    if (k >= 3u) {
-      highp uint numerator = bottom * bottom + bottom + 1u;
-      highp float estimate = skinpackRowEstimate(float(bottom), float(numerator / 3u - rest), float(numerator % 3u));
-      row = skinpackSearch(false, bottom, (2u * bottom + 1u) / 3u - 1u, estimate, rest);
-      rest -= skinpackRowBase(bottom, row);
-    }
-    q.w = k == 4u ? layer : 0u;
-    q.z = k >= 3u ? row + layer : 0u;
-    q.y = rest + row + layer;
-    q.x = scale - q.y - q.z - q.w;
-    return vec4(q) / float(scale); // division: bit-identical to the C decoder's double q * (1/s) on SwiftShader
-  }
-  highp uint first = method == 0u ? 0u : 1u; // fixed stores q1 too
-  highp uint shift = 0u;
-  for (highp uint slot = first; slot < k; ++slot) {
-    highp uint width = skinpackBits[slot - first];
-    q[slot] = skinpackLowBits(code >> shift, width);
-    shift += width;
-  }
-  if (first == 1u) q.x = scale - (q.y + q.z + q.w);
-  return vec4(q) / float(scale);
+#if SKINPACK_K == 1
+  q.x = SKINPACK_SCALE;
+  return vec4(1.0, 0.0, 0.0, 0.0);
+#elif SKINPACK_METHOD == 3 // any: mixed radix, w_i = x_i / (i (q_i - 1)), w1 = 1 - the rest
+  highp vec4 w = vec4(0.0);
+  q.y = code % SKINPACK_AXIS2;
+  w.y = float(q.y) / skinpackDivisors.y;
+#if SKINPACK_K >= 3
+  code /= SKINPACK_AXIS2;
+  q.z = code % SKINPACK_AXIS3;
+  w.z = float(q.z) / skinpackDivisors.z;
+#endif
+#if SKINPACK_K == 4
+  code /= SKINPACK_AXIS3;
+  q.w = code % SKINPACK_AXIS4;
+  w.w = float(q.w) / skinpackDivisors.w;
+#endif
+  w.x = 1.0 - (w.y + w.z + w.w);
+  return w;
+#else
+#if SKINPACK_METHOD == 4 // oss: layer k, row j, index i; q4 = k, q3 = j + k, q2 = i + j + k
+  highp uint layer = 0u, row = 0u, rest = code, base;
+#if SKINPACK_K == 4
+  layer = skinpackLayer(code, base);
+  rest -= base;
+#endif
+#if SKINPACK_K >= 3
+  row = skinpackRow(SKINPACK_N - 2u * layer, rest, base);
+  rest -= base;
+#endif
+  q.w = layer;
+#if SKINPACK_K >= 3
+  q.z = row + layer;
+#endif
+  q.y = rest + row + layer;
+  q.x = SKINPACK_SCALE - q.y - q.z - q.w;
+#else // fixed stores q1..qK, cube and pot q2..qK
+  SKINPACK_UNPACK_GRID(code, q)
+#if SKINPACK_METHOD != 0
+  q.x = SKINPACK_SCALE - (q.y + q.z + q.w);
+#endif
+#endif
+  return vec4(q) / skinpackDivisors.x; // a division: bit-identical to the C decoder's double q * (1/s) on SwiftShader
+#endif
 }
+
 // One packed vertex word -> joints (zero-weight slots: joint 0, as skinpack decompress) and weights.
 void skinpackDecode(highp uint word, out highp uvec4 joints, out highp vec4 weights, out highp uvec4 q) {
-  highp uint weightBits = skinpackConfig.z;
-  highp uint code = skinpackLowBits(word, weightBits);
-  highp uint tuple = weightBits >= 32u ? 0u : word >> weightBits;
+  highp uint code = word & SKINPACK_CODE_MASK;
+#if SKINPACK_WEIGHT_BITS < 32
+  highp uint tuple = word >> SKINPACK_WEIGHT_BITS;
+#else
+  highp uint tuple = 0u;
+#endif
   weights = skinpackDecodeWeights(code, q);
-  highp uint width = skinpackParams.w;
-  joints = texelFetch(skinpackTuples, ivec2(int(tuple % width), int(tuple / width)), 0);
-  for (int s = 0; s < 4; ++s) if (!(weights[s] > 0.0)) joints[s] = 0u;
+  joints = texelFetch(skinpackTuples, ivec2(int(tuple & SKINPACK_ROW_MASK), int(tuple >> SKINPACK_ROW_BITS)), 0);
+  joints *= uvec4(greaterThan(weights, vec4(0.0)));
 }
 `;
+
+/** The decoder of one codec (GLSL ES 3.00): skinpackDecode(word, out joints, out weights, out q). */
+export function decodeGlsl(codec, rowWidth = TUPLE_TEXTURE_WIDTH) {
+  return codecDefines(codec, rowWidth) + DECODE_BODY;
+}
+
+/** skinpackDivisors of a codec: s (grid methods) or i (q_i - 1) (any, binary64 like the CPU decoder, then binary32). */
+export function codecDivisors(codec) {
+  if (codec.method === 'any') return [1, ...codec.axisDivisors, 0, 0].slice(0, 4);
+  return [Number(codec.scale), 0, 0, 0];
+}
+
+/** The uniforms of the GPU skin (three.js form): the tuple texture and the weights' divisors. */
+export function gpuSkinUniforms(codec, tupleTexture) {
+  return { skinpackTuples: { value: tupleTexture }, skinpackDivisors: { value: new Vector4(...codecDivisors(codec)) } };
+}
 
 // three's skinning chunks with the attributes replaced by the decoded values.
 function renamed(chunk) {
   return chunk.replace(/\bskinIndex\b/g, 'skinpackIndex').replace(/\bskinWeight\b/g, 'skinpackWeight');
 }
 
-/** The program variant of a codec: method and K are compile-time constants of the shader. */
+/** The program variant of a codec: three.js shares a program between materials with one key,
+ *  and every codec parameter is a constant of the program. */
 export function codecProgramKey(codec) {
-  return `skinpack-gpu-${codec.methodId}-${codec.influences}`;
+  return `skinpack-gpu;${codecDefines(codec).replace(/#define SKINPACK_/g, '').replace(/\n/g, ';')}`;
 }
 
-/** Patches a three.js shader (onBeforeCompile's argument) to skin from the packed word. */
+/** Patches a three.js shader (onBeforeCompile's argument) to skin from the packed word: one
+ *  decode a vertex, in skinbase_vertex; skinnormal_vertex and skinning_vertex use its result. */
 export function patchSkinningShader(shader, uniforms, codec) {
   Object.assign(shader.uniforms, uniforms);
-  const constants = `#define SKINPACK_METHOD ${codec.methodId}u\n#define SKINPACK_K ${codec.influences}u\n`;
   shader.vertexShader = shader.vertexShader
     .replace('#include <skinning_pars_vertex>',
-             `#include <skinning_pars_vertex>\n#ifdef USE_SKINNING\nin highp uint skinpackWord;\n${constants}${DECODE_GLSL}\n#endif`)
+             `#include <skinning_pars_vertex>\n#ifdef USE_SKINNING\nin highp uint skinpackWord;\n${decodeGlsl(codec)}\n#endif`)
     .replace('#include <skinbase_vertex>',
              `#ifdef USE_SKINNING\nhighp uvec4 skinpackJoints; highp vec4 skinpackWeight; highp uvec4 skinpackQ;\n` +
              `skinpackDecode(skinpackWord, skinpackJoints, skinpackWeight, skinpackQ);\n` +

@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { SkinpackGLTFPlugin, skinpackData } from '/src/SkinpackGLTFPlugin.js';
-import { DECODE_GLSL, codecUniformValues, tupleTexels } from '/src/gpu.js';
+import { codecDivisors, decodeGlsl, tupleTexels } from '/src/gpu.js';
 import { codecFromExtension } from '/src/decode.js';
 
 const SIZE = 256;
@@ -132,11 +132,12 @@ async function loadError(url, decode) {
 
 // ---- GPU decode read back through an integer render target -------------------------------------
 
-const READBACK_VERTEX = `#version 300 es
+// The decoder the skinning shaders run, for one codec (its constants) and tuple row width.
+const readbackVertex = (codec, rowWidth) => `#version 300 es
 precision highp float; precision highp int; precision highp usampler2D;
 in highp uint skinpackWord;
 uniform highp uint width;
-${DECODE_GLSL}
+${decodeGlsl(codec, rowWidth)}
 flat out highp uvec4 vQ, vJ, vW;
 void main() {
   highp uvec4 joints; highp vec4 weights; highp uvec4 q;
@@ -162,25 +163,35 @@ function compile(gl, type, source) {
   return shader;
 }
 
-let readback = null; // one WebGL2 context and program for every read-back
+let readback = null; // one WebGL2 context for every read-back, one program per decoder source
 
 function readbackContext() {
   if (readback) return readback;
   const canvas = document.createElement('canvas');
   const gl = canvas.getContext('webgl2');
-  const program = gl.createProgram();
-  gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, READBACK_VERTEX));
-  gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, READBACK_FRAGMENT));
-  gl.linkProgram(program);
-  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
-  readback = { gl, program, table: gl.createTexture(), words: gl.createBuffer(), framebuffer: gl.createFramebuffer(),
-               targets: [0, 1, 2].map(() => gl.createTexture()) };
+  readback = { gl, programs: new Map(), fragment: compile(gl, gl.FRAGMENT_SHADER, READBACK_FRAGMENT), table: gl.createTexture(),
+               words: gl.createBuffer(), framebuffer: gl.createFramebuffer(), targets: [0, 1, 2].map(() => gl.createTexture()) };
   return readback;
+}
+
+function readbackProgram(codec, rowWidth) {
+  const { gl, programs, fragment } = readbackContext();
+  const source = readbackVertex(codec, rowWidth);
+  if (!programs.has(source)) {
+    const program = gl.createProgram();
+    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, source));
+    gl.attachShader(program, fragment);
+    gl.linkProgram(program);
+    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+    programs.set(source, program);
+  }
+  return programs.get(source);
 }
 
 /** Decodes words (one a vertex) with tuple table lut in the shader; returns q, joints, weight bits. */
 function gpuDecode(codec, words, lut, rowWidth) {
-  const { gl, program, table, words: buffer, framebuffer, targets } = readbackContext();
+  const { gl, table, words: buffer, framebuffer, targets } = readbackContext();
+  const program = readbackProgram(codec, rowWidth);
   const vertexCount = words.length;
   const width = Math.max(1, Math.ceil(Math.sqrt(vertexCount)));
   gl.useProgram(program);
@@ -190,14 +201,9 @@ function gpuDecode(codec, words, lut, rowWidth) {
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
   gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA16UI, lutWidth, lutHeight, 0, gl.RGBA_INTEGER, gl.UNSIGNED_SHORT, texels);
-  const values = codecUniformValues(codec, lutWidth);
   gl.uniform1i(gl.getUniformLocation(program, 'skinpackTuples'), 0);
   gl.uniform1ui(gl.getUniformLocation(program, 'width'), width);
-  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackConfig'), values.config);
-  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackParams'), values.params);
-  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackBits'), values.bits);
-  gl.uniform4uiv(gl.getUniformLocation(program, 'skinpackAxes'), values.axes);
-  gl.uniform4fv(gl.getUniformLocation(program, 'skinpackFactors'), values.factors);
+  gl.uniform4fv(gl.getUniformLocation(program, 'skinpackDivisors'), codecDivisors(codec));
   gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
   gl.bufferData(gl.ARRAY_BUFFER, words, gl.STATIC_DRAW);
   const location = gl.getAttribLocation(program, 'skinpackWord');
