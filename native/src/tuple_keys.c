@@ -9,8 +9,11 @@
 
 #include "tuple_keys.h"
 
-/* The smallest table (slots); it doubles whenever half full. */
+/* The smallest table (slots). It doubles past load 1/4 while it is small, so that few keys
+ * miss the slot they hash to (at load 1/2 about a fifth do, and each costs a branch miss),
+ * and past load 1/2 once it has outgrown the caches anyway. */
 #define FIRST_CAPACITY 256
+#define SPARSE_CAPACITY 4096
 #define EMPTY UINT32_MAX /* the count of an empty slot: counts are <= 4 */
 
 typedef struct key_slot {
@@ -26,11 +29,16 @@ typedef struct key_table {
     sp_tuple_keys* keys;
 } key_table;
 
-/* A key for every vertex fits at load 1/2. */
+static int overloaded(size_t keys, size_t capacity)
+{
+    return keys * (capacity <= SPARSE_CAPACITY ? 4 : 2) > capacity;
+}
+
+/* Enough for a key for every vertex (then at most half full). */
 static size_t max_capacity(size_t vertex_count)
 {
     size_t capacity = FIRST_CAPACITY;
-    while (capacity < 2 * vertex_count) capacity *= 2;
+    while (overloaded(vertex_count, capacity)) capacity *= 2;
     return capacity;
 }
 
@@ -76,7 +84,7 @@ static void grow(key_table* t)
     for (size_t id = 0; id < r->size; ++id) place(t, r->keys[id], r->counts[id], (uint32_t)id);
 }
 
-/* The id of a key that is not in the slot it hashes to: further along, or a new one. */
+/* The id of a key, found from the slot it hashes to on, or a new one. */
 static uint32_t find_or_add(key_table* t, uint64_t key, uint32_t count, size_t vertex)
 {
     size_t mask = t->capacity - 1;
@@ -87,7 +95,7 @@ static uint32_t find_or_add(key_table* t, uint64_t key, uint32_t count, size_t v
     r->keys[id] = key;
     r->first[id] = (uint32_t)vertex;
     r->counts[id] = (uint8_t)count;
-    if (2 * r->size > t->capacity && t->capacity < t->max_capacity) grow(t);
+    if (overloaded(r->size, t->capacity) && t->capacity < t->max_capacity) grow(t);
     else place(t, key, count, id);
     return id;
 }
@@ -99,33 +107,96 @@ SP_INLINE uint32_t key_id(key_table* t, uint64_t key, uint32_t count, size_t ver
     return slot->key == key && slot->count == count ? slot->id : find_or_add(t, key, count, vertex);
 }
 
+/* Vertices a step: each step runs as the one before it suggests. */
+#define STEP 256
+
+/* Each count's last key and its id, and its prefix mask (here, next to them, rather than in a
+ * table that takes a register in the loop). */
+typedef struct last_keys {
+    uint64_t key[5];
+    uint64_t mask[5];
+    uint32_t id[5];
+} last_keys;
+
 /*
- * Inlined per K and with or without counts, so that a key is one masked load. Each count keeps
- * the last key it saw and that key's id: along a mesh, neighbouring vertices share their joints
- * while their counts vary, so nearly every vertex is one compare with the last key of its count
- * and the table is looked up once a run. A cache starts on a key no vertex of its count has:
- * all ones for a prefix shorter than 4 joints (its top joint is masked to 0), and for full
- * 4-joint tuples anything but the first one's.
+ * A cache starts on a key no vertex of its count has: all ones for a prefix shorter than 4
+ * joints (its top joint is masked to 0), and for full 4-joint tuples anything but the first
+ * one's.
  */
-SP_INLINE void collect(key_table* t, const uint16_t* joints, const uint8_t* significant, size_t vertex_count,
-                       size_t k, uint32_t* ids)
+static void start_last_keys(last_keys* last, const uint16_t* joints, const uint8_t* significant,
+                            size_t vertex_count, size_t k)
 {
     static const uint64_t prefix_mask[5] = {0xffff, 0xffff, 0xffffffff, 0xffffffffffff, ~(uint64_t)0};
-    uint64_t last_key[5] = {~(uint64_t)0, ~(uint64_t)0, ~(uint64_t)0, ~(uint64_t)0, ~(uint64_t)0};
-    uint32_t last_id[5] = {0, 0, 0, 0, 0};
+    for (size_t count = 0; count < 5; ++count)
+        last->key[count] = ~(uint64_t)0, last->mask[count] = prefix_mask[count], last->id[count] = 0;
     if (k == 4) {
         const uint8_t* full = significant ? memchr(significant, 4, vertex_count) : NULL;
         size_t first = significant ? (full ? (size_t)(full - significant) : vertex_count) : 0;
-        if (first < vertex_count) last_key[4] = ~sp_tuple_prefix_key(joints + first * 4, 4, 4);
+        if (first < vertex_count) last->key[4] = ~sp_tuple_prefix_key(joints + first * 4, 4, 4);
     }
-    for (size_t v = 0; v < vertex_count; ++v) {
-        uint32_t count = significant ? significant[v] : (uint32_t)k;
-        uint64_t key = sp_tuple_prefix_key(joints + v * k, k, 4) & prefix_mask[count];
-        if (key != last_key[count]) {
-            last_key[count] = key;
-            last_id[count] = key_id(t, key, count, v);
+}
+
+/* Vertex v's key: its joints (k of them, a constant where inlined) masked to its count (all k
+ * without counts). */
+SP_INLINE uint64_t vertex_key(const last_keys* last, const uint16_t* joints, const uint8_t* significant, size_t v,
+                              size_t k, uint32_t* count)
+{
+    uint64_t key = sp_tuple_prefix_key(joints + v * k, k, 4);
+    *count = significant ? significant[v] : (uint32_t)k;
+    return significant ? key & last->mask[*count] : key;
+}
+
+/* Vertices [first, end) by their count's last key, the table only when it changes (along a
+ * mesh, neighbours share their joints while their counts vary). Returns the changes. */
+SP_INLINE size_t collect_runs(key_table* t, last_keys* last, const uint16_t* joints, const uint8_t* significant,
+                              size_t first, size_t end, size_t k, uint32_t* ids)
+{
+    size_t changes = 0;
+    for (size_t v = first; v < end; ++v) {
+        uint32_t count;
+        uint64_t key = vertex_key(last, joints, significant, v, k, &count);
+        if (key != last->key[count]) { /* the call, not key_id inlined: fewer registers in the loop */
+            last->key[count] = key;
+            last->id[count] = find_or_add(t, key, count, v);
+            ++changes;
         }
-        ids[v] = last_id[count];
+        ids[v] = last->id[count];
+    }
+    return changes;
+}
+
+/* Vertices [first, end) by the table, where the last keys change too often for that branch to be
+ * predicted; keeps the last keys. Returns the vertices that had their count's last key. */
+SP_INLINE size_t collect_hashed(key_table* t, last_keys* last, const uint16_t* joints, const uint8_t* significant,
+                                size_t first, size_t end, size_t k, uint32_t* ids)
+{
+    size_t repeats = 0;
+    for (size_t v = first; v < end; ++v) {
+        uint32_t count;
+        uint64_t key = vertex_key(last, joints, significant, v, k, &count);
+        uint32_t id = key_id(t, key, count, v);
+        repeats += key == last->key[count];
+        last->key[count] = key;
+        last->id[count] = id;
+        ids[v] = id;
+    }
+    return repeats;
+}
+
+/* Inlined per K and with or without counts. Steps of vertices go by their last keys while at
+ * most one in 8 changes them, else by the table until 7 in 8 repeat them again. */
+SP_INLINE void collect(key_table* t, const uint16_t* joints, const uint8_t* significant, size_t vertex_count,
+                       size_t k, uint32_t* ids)
+{
+    last_keys last;
+    start_last_keys(&last, joints, significant, vertex_count, k);
+    int by_runs = 1;
+    for (size_t first = 0; first < vertex_count; first += STEP) {
+        size_t end = vertex_count - first < STEP ? vertex_count : first + STEP;
+        if (by_runs)
+            by_runs = 8 * collect_runs(t, &last, joints, significant, first, end, k, ids) <= end - first;
+        else
+            by_runs = 8 * collect_hashed(t, &last, joints, significant, first, end, k, ids) >= 7 * (end - first);
     }
 }
 
