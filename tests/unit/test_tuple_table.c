@@ -8,7 +8,8 @@
  * (commit 709f921 for the first 64 cases, 3906c1f for the rest). The later cases aim at the
  * one-pass key builder: joints over the whole 16-bit range (a 4-joint key uses all 64 bits, and
  * the all-65535 tuple is the first one), counts of 0, more keys than the first table holds,
- * keys that all hash to one slot, sizes that are not a multiple of 8, and bad counts.
+ * keys that all hash to one slot, inputs with and without runs, sizes that are not a multiple of
+ * 8, and bad counts.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -151,6 +152,17 @@ static void make_colliding_input(uint64_t seed, size_t k, int runs)
     }
 }
 
+/* Long runs of one tuple, then none, then long runs again: the key pass goes by its last keys,
+ * then by the table, then back. */
+static void make_mixed_input(uint64_t seed, size_t k)
+{
+    make_input(seed, k, 64, 0, joints, significant);
+    for (size_t v = 0; v < V; ++v) {
+        size_t from = v < V / 3 ? v - v % 500 : v < 2 * V / 3 ? v : v - v % 300;
+        memcpy(joints + v * k, joints + from * k, k * sizeof(uint16_t));
+    }
+}
+
 /* Counts above K anywhere (the first vertex, one inside an 8-vertex step, one in the tail after
  * the last step) fail and leave the outputs alone. */
 static void check_bad_counts(void)
@@ -195,6 +207,11 @@ int main(void)
                 make_colliding_input(case_number + 1, k, runs);
                 check_case("colliding keys, runs", V, k, merge, (unsigned)runs);
             }
+    for (size_t k = 1; k <= 4; ++k)
+        for (int merge = 0; merge < 2; ++merge) {
+            make_mixed_input(case_number + 1, k);
+            check_case("runs, none, runs", V, k, merge, 0);
+        }
     static const size_t sizes[] = {0, 1, 7, 9, 255, 257, V - 1};
     for (size_t k = 3; k <= 4; ++k)
         for (size_t i = 0; i < sizeof(sizes) / sizeof(sizes[0]); ++i) {
