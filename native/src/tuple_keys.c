@@ -1,9 +1,9 @@
 /*
  * The distinct keys of a mesh's vertices for the tuple table (tuple_lut.c): one pass over the
- * vertices that masks each one's joints to its significant prefix and looks the key up in an
- * open-addressing table. The table starts small and doubles, so for the few hundred keys of a
- * typical mesh it stays in L1 and nearly every vertex is one multiply, one probe and one store;
- * the table rule then runs on the distinct keys only.
+ * vertices that masks each one's joints to its significant prefix and compares the key with the
+ * last one of the same count, looking it up in an open-addressing table only when it changed (or
+ * on every vertex where too many change). The table starts small and doubles, so for the few
+ * hundred keys of a typical mesh it stays in L1; the table rule then runs on the distinct keys.
  */
 #include <string.h>
 
@@ -146,16 +146,25 @@ SP_INLINE uint64_t vertex_key(const last_keys* last, const uint16_t* joints, con
     return significant ? key & last->mask[*count] : key;
 }
 
-/* Vertices [first, end) by their count's last key, the table only when it changes (along a
- * mesh, neighbours share their joints while their counts vary). Returns the changes. */
-SP_INLINE size_t collect_runs(key_table* t, last_keys* last, const uint16_t* joints, const uint8_t* significant,
-                              size_t first, size_t end, size_t k, uint32_t* ids)
+/*
+ * Vertices [first, end) by their count's last key, the table only when it changes (along a
+ * mesh, neighbours share their joints while their counts vary); or, where that branch would be
+ * mispredicted too often, by the table, keeping the last keys. Returns the vertices whose key
+ * differs from their count's last one.
+ */
+SP_INLINE size_t collect_step(key_table* t, last_keys* last, const uint16_t* joints, const uint8_t* significant,
+                              size_t first, size_t end, size_t k, int by_table, uint32_t* ids)
 {
     size_t changes = 0;
     for (size_t v = first; v < end; ++v) {
         uint32_t count;
         uint64_t key = vertex_key(last, joints, significant, v, k, &count);
-        if (key != last->key[count]) { /* the call, not key_id inlined: fewer registers in the loop */
+        if (by_table) {
+            uint32_t id = key_id(t, key, count, v);
+            changes += key != last->key[count];
+            last->key[count] = key;
+            last->id[count] = id;
+        } else if (key != last->key[count]) { /* the call, not key_id inlined: fewer registers in the loop */
             last->key[count] = key;
             last->id[count] = find_or_add(t, key, count, v);
             ++changes;
@@ -165,38 +174,21 @@ SP_INLINE size_t collect_runs(key_table* t, last_keys* last, const uint16_t* joi
     return changes;
 }
 
-/* Vertices [first, end) by the table, where the last keys change too often for that branch to be
- * predicted; keeps the last keys. Returns the vertices that had their count's last key. */
-SP_INLINE size_t collect_hashed(key_table* t, last_keys* last, const uint16_t* joints, const uint8_t* significant,
-                                size_t first, size_t end, size_t k, uint32_t* ids)
-{
-    size_t repeats = 0;
-    for (size_t v = first; v < end; ++v) {
-        uint32_t count;
-        uint64_t key = vertex_key(last, joints, significant, v, k, &count);
-        uint32_t id = key_id(t, key, count, v);
-        repeats += key == last->key[count];
-        last->key[count] = key;
-        last->id[count] = id;
-        ids[v] = id;
-    }
-    return repeats;
-}
-
-/* Inlined per K and with or without counts. Steps of vertices go by their last keys while at
- * most one in 8 changes them, else by the table until 7 in 8 repeat them again. */
+/* Inlined per K and with or without counts. A step of vertices goes by the last keys when at
+ * most one in 8 of the step before changed them, else by the table (two calls, so that each mode
+ * is its own loop). */
 SP_INLINE void collect(key_table* t, const uint16_t* joints, const uint8_t* significant, size_t vertex_count,
                        size_t k, uint32_t* ids)
 {
     last_keys last;
     start_last_keys(&last, joints, significant, vertex_count, k);
-    int by_runs = 1;
+    int by_table = 0;
     for (size_t first = 0; first < vertex_count; first += STEP) {
         size_t end = vertex_count - first < STEP ? vertex_count : first + STEP;
-        if (by_runs)
-            by_runs = 8 * collect_runs(t, &last, joints, significant, first, end, k, ids) <= end - first;
+        if (by_table)
+            by_table = 8 * collect_step(t, &last, joints, significant, first, end, k, 1, ids) > end - first;
         else
-            by_runs = 8 * collect_hashed(t, &last, joints, significant, first, end, k, ids) >= 7 * (end - first);
+            by_table = 8 * collect_step(t, &last, joints, significant, first, end, k, 0, ids) > end - first;
     }
 }
 
