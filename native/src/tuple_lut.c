@@ -7,9 +7,9 @@
  * prefixes; entries in order of first use), never on the hash. A vertex's entry depends only on
  * its significant prefix and the prefixes before it, so one pass (tuple_keys.c) numbers the
  * distinct (count, prefix) keys in order of first use, the rule runs on those few keys, and a
- * last pass maps each vertex's key number to its entry (skipped when they are the same). The
- * prefix table starts small and doubles, so a mesh with few tuples neither clears nor misses on
- * a table sized for the worst case.
+ * last pass maps each vertex's key number to its entry (skipped when they are the same; without
+ * merging, every distinct tuple is its own entry). The prefix table starts small and doubles, so
+ * a mesh with few tuples neither clears nor misses on a table sized for the worst case.
  */
 #include <string.h>
 
@@ -55,9 +55,10 @@ static size_t table_region_bytes(size_t vertex_count, size_t k)
     return ((keys > prefixes ? keys : prefixes) + 7) & ~(size_t)7;
 }
 
+/* The scratch from its first 8-byte boundary on. */
 static size_t scratch_bytes(size_t vertex_count, size_t k)
 {
-    return table_region_bytes(vertex_count, k) + sp_tuple_keys_record_bytes(vertex_count) +
+    return 7 + table_region_bytes(vertex_count, k) + sp_tuple_keys_record_bytes(vertex_count) +
            vertex_count * sizeof(uint32_t);
 }
 
@@ -178,7 +179,7 @@ sp_result sp_build_tuple_lut(const uint16_t* joints, const uint8_t* significant,
     size_t k = influences;
     if (significant && !counts_at_most(significant, vertex_count, k)) return SP_ERR_INVALID_ARGUMENT;
 
-    unsigned char* region = (unsigned char*)scratch;
+    unsigned char* region = (unsigned char*)scratch + (8 - (uintptr_t)scratch % 8) % 8;
     unsigned char* records = region + table_region_bytes(vertex_count, k);
     uint32_t* entry_of = (uint32_t*)(records + sp_tuple_keys_record_bytes(vertex_count));
     sp_tuple_keys keys;
