@@ -4,15 +4,17 @@
  * zero weight ("don't care") can reuse any tuple that starts with its significant joints.
  *
  * The output depends only on the rule (full tuples first, then ever shorter significant
- * prefixes; entries in order of first use), never on the hash: the table starts small and
- * doubles, so a mesh with few tuples neither clears nor misses on a table sized for the worst
- * case; the vertices are bucketed by prefix length once, not scanned once per length; and a
- * vertex with the prefix of the one before it (runs along a mesh) takes its entry without a
- * lookup.
+ * prefixes; entries in order of first use), never on the hash. A vertex's entry depends only on
+ * its significant prefix and the prefixes before it, so one pass (tuple_keys.c) numbers the
+ * distinct (count, prefix) keys in order of first use, the rule runs on those few keys, and a
+ * last pass maps each vertex's key number to its entry (skipped when they are the same; without
+ * merging, every distinct tuple is its own entry). The prefix table starts small and doubles, so
+ * a mesh with few tuples neither clears nor misses on a table sized for the worst case.
  */
 #include <string.h>
 
 #include "skinpack.h"
+#include "tuple_keys.h"
 
 /* The smallest table (slots); it doubles whenever half full. */
 #define FIRST_CAPACITY 256
@@ -29,37 +31,42 @@ typedef struct lut_builder {
     unsigned char* regions; /* a table of capacity full at 0, one of full/2 after it */
 } lut_builder;
 
-static size_t table_capacity(size_t vertex_count, size_t k)
+static size_t table_capacity(size_t entries, size_t k)
 {
-    size_t keys = vertex_count * k, capacity = FIRST_CAPACITY;
+    size_t keys = entries * k, capacity = FIRST_CAPACITY;
     while (capacity < 2 * keys) capacity *= 2;
     return capacity;
 }
 
 #define SLOT_BYTES (sizeof(uint32_t) + 1)
 
-/* Two table regions (the doubling moves between them) and the vertices bucketed by length. */
+/* Two prefix table regions: the doubling moves between them. */
+static size_t prefix_table_bytes(size_t entries, size_t k)
+{
+    size_t full = table_capacity(entries, k);
+    return (full + full / 2) * SLOT_BYTES;
+}
+
+/* One region for the key pass's table and then the prefix tables, the key records, and each
+ * key's entry. */
+static size_t table_region_bytes(size_t vertex_count, size_t k)
+{
+    size_t keys = sp_tuple_keys_table_bytes(vertex_count), prefixes = prefix_table_bytes(vertex_count, k);
+    return ((keys > prefixes ? keys : prefixes) + 7) & ~(size_t)7;
+}
+
+/* The scratch from its first 8-byte boundary on. */
 static size_t scratch_bytes(size_t vertex_count, size_t k)
 {
-    size_t full = table_capacity(vertex_count, k);
-    return (full + full / 2) * SLOT_BYTES + vertex_count * sizeof(uint32_t);
+    return 7 + table_region_bytes(vertex_count, k) + sp_tuple_keys_record_bytes(vertex_count) +
+           vertex_count * sizeof(uint32_t);
 }
 
 size_t sp_tuple_lut_scratch_bound(size_t vertex_count, size_t influences)
 {
     if (influences < 1) influences = 1;
+    if (influences > SP_MAX_INFLUENCES) influences = SP_MAX_INFLUENCES;
     return scratch_bytes(vertex_count, influences);
-}
-
-/* The first `length` joints as one key (K <= 4 joints of 16 bits): all K read without a loop
- * over the length, the slots past it masked off. */
-static inline uint64_t prefix_key(const uint16_t* joints, size_t k, size_t length)
-{
-    uint64_t key = joints[0];
-    if (k > 1) key |= (uint64_t)joints[1] << 16;
-    if (k > 2) key |= (uint64_t)joints[2] << 32;
-    if (k > 3) key |= (uint64_t)joints[3] << 48;
-    return length >= 4 ? key : key & ((((uint64_t)1) << (16 * length)) - 1);
 }
 
 static inline size_t slot_of(const lut_builder* b, uint64_t key, size_t length)
@@ -74,7 +81,7 @@ static size_t find_slot(const lut_builder* b, uint64_t key, size_t length)
     for (size_t at = slot_of(b, key, length);; at = (at + 1) & mask) {
         uint32_t entry = b->slots[at];
         if (entry == 0) return at;
-        if (b->lengths[at] == length && prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length) == key) return at;
+        if (b->lengths[at] == length && sp_tuple_prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length) == key) return at;
     }
 }
 
@@ -104,7 +111,7 @@ static void grow(lut_builder* b)
         uint32_t entry = old_slots[i];
         if (entry == 0) continue;
         size_t length = old_lengths[i], mask = b->capacity - 1;
-        size_t at = slot_of(b, prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length), length);
+        size_t at = slot_of(b, sp_tuple_prefix_key(b->lut + (size_t)(entry - 1) * b->k, b->k, length), length);
         while (b->slots[at]) at = (at + 1) & mask;
         b->slots[at] = entry;
         b->lengths[at] = (uint8_t)length;
@@ -118,7 +125,7 @@ static uint32_t add_entry(lut_builder* b, const uint16_t* joints, size_t first_l
     memcpy(b->lut + (size_t)entry * b->k, joints, b->k * sizeof(uint16_t));
     for (size_t length = first_length; length <= b->k; ++length) {
         if (2 * (b->used + 1) > b->capacity && b->capacity < b->full) grow(b);
-        size_t at = find_slot(b, prefix_key(joints, b->k, length), length);
+        size_t at = find_slot(b, sp_tuple_prefix_key(joints, b->k, length), length);
         if (b->slots[at] == 0) {
             b->slots[at] = entry + 1;
             b->lengths[at] = (uint8_t)length;
@@ -128,55 +135,37 @@ static uint32_t add_entry(lut_builder* b, const uint16_t* joints, size_t first_l
     return entry;
 }
 
-/* Finds or adds the entry of one vertex's prefix of `length`; a vertex with the same prefix as
- * the one before it in the pass reuses its entry without a lookup. */
-static inline void index_vertex(lut_builder* b, const uint16_t* tuple, size_t length, size_t register_from,
-                                uint64_t* last_key, uint32_t* last_entry, uint32_t* index)
+/* Whether every significant count is at most k (<= 4), eight counts a step: a count above k
+ * is 8 or more, or sets bit 3 of count + 7 - k (no carries below 8). */
+static int counts_at_most(const uint8_t* significant, size_t vertex_count, size_t k)
 {
-    uint64_t key = prefix_key(tuple, b->k, length);
-    if (key != *last_key || *last_entry == UINT32_MAX) {
-        size_t at = find_slot(b, key, length);
-        *last_entry = b->slots[at] ? b->slots[at] - 1 : add_entry(b, tuple, register_from);
-        *last_key = key;
+    const uint64_t ones = 0x0101010101010101ull;
+    uint64_t above = 0;
+    size_t v = 0;
+    for (; v + 8 <= vertex_count; v += 8) {
+        uint64_t counts;
+        memcpy(&counts, significant + v, sizeof(counts));
+        above |= (counts & (0xf8 * ones)) | ((counts + (7 - k) * ones) & (0x08 * ones));
     }
-    *index = *last_entry;
+    for (; v < vertex_count; ++v) above |= significant[v] > k;
+    return above == 0;
 }
 
-/* Vertices by prefix length (a count of 0 counts as 1), each length's in vertex order: a
- * stable counting sort, so each pass reads only its own vertices (scanning all of them once
- * per length cost a branch miss on nearly every vertex). start[l] .. start[l - 1] holds
- * length l. Fails on a count above k. */
-static int bucket_by_length(const uint8_t* significant, size_t vertex_count, size_t k, uint32_t* order,
-                            size_t* start)
+/* The rule on the distinct keys, which stand for their vertices: full prefixes first, then ever
+ * shorter ones, each length's keys in order of first use; a new entry takes the joints of the
+ * key's first vertex and registers all its prefixes. Returns whether every key is its own entry. */
+static int assign_entries(lut_builder* b, const uint16_t* joints, const sp_tuple_keys* keys, uint32_t* entry_of)
 {
-    size_t count[8] = {0};
-    unsigned seen = 0;
-    /* one branch-free pass: eight 8-bit counters in one word (by value & 7), emptied every 255
-     * vertices; values of 8 and more show in the OR of all */
-    for (size_t first = 0; first < vertex_count; first += 255) {
-        size_t end = vertex_count - first < 255 ? vertex_count : first + 255;
-        uint64_t packed = 0;
-        for (size_t v = first; v < end; ++v) {
-            packed += (uint64_t)1 << ((significant[v] & 7) * 8);
-            seen |= significant[v];
+    int same = 1;
+    for (size_t length = b->k; length >= 1; --length)
+        for (size_t id = 0; id < keys->size; ++id) {
+            size_t count = keys->counts[id] ? keys->counts[id] : 1;
+            if (count != length) continue;
+            size_t at = find_slot(b, keys->keys[id], length);
+            entry_of[id] = b->slots[at] ? b->slots[at] - 1 : add_entry(b, joints + (size_t)keys->first[id] * b->k, 1);
+            same &= entry_of[id] == id;
         }
-        for (size_t value = 0; value < 8; ++value) count[value] += (size_t)(packed >> (8 * value)) & 255;
-    }
-    if (seen > 7) return 0;
-    for (size_t value = k + 1; value < 8; ++value)
-        if (count[value]) return 0;
-    count[1] = vertex_count;
-    for (size_t length = 2; length <= k; ++length) count[1] -= count[length];
-    start[k] = 0; /* the longest prefixes first */
-    for (size_t length = k; length > 1; --length) start[length - 1] = start[length] + count[length];
-    start[0] = vertex_count;
-    size_t at[SP_MAX_INFLUENCES + 1];
-    memcpy(at, start, sizeof(at));
-    for (size_t v = 0; v < vertex_count; ++v) {
-        size_t needed = significant[v] < 1 ? 1 : significant[v];
-        order[at[needed]++] = (uint32_t)v;
-    }
-    return 1;
+    return same;
 }
 
 sp_result sp_build_tuple_lut(const uint16_t* joints, const uint8_t* significant, size_t vertex_count,
@@ -187,25 +176,26 @@ sp_result sp_build_tuple_lut(const uint16_t* joints, const uint8_t* significant,
         vertex_count > UINT32_MAX)
         return SP_ERR_INVALID_ARGUMENT;
     if (!scratch || scratch_size < scratch_bytes(vertex_count, influences)) return SP_ERR_BUFFER_TOO_SMALL;
+    size_t k = influences;
+    if (significant && !counts_at_most(significant, vertex_count, k)) return SP_ERR_INVALID_ARGUMENT;
 
-    size_t k = influences, full = table_capacity(vertex_count, k);
-    lut_builder b = {lut, 0, k, NULL, NULL, 0, 0, 64, full, (unsigned char*)scratch};
-    uint32_t* order = (uint32_t*)((unsigned char*)scratch + (full + full / 2) * SLOT_BYTES);
-    size_t start[SP_MAX_INFLUENCES + 1];
-    if (significant && !bucket_by_length(significant, vertex_count, k, order, start)) return SP_ERR_INVALID_ARGUMENT;
-    start_table(&b, FIRST_CAPACITY < full ? FIRST_CAPACITY : full);
+    unsigned char* region = (unsigned char*)scratch + (8 - (uintptr_t)scratch % 8) % 8;
+    unsigned char* records = region + table_region_bytes(vertex_count, k);
+    uint32_t* entry_of = (uint32_t*)(records + sp_tuple_keys_record_bytes(vertex_count));
+    sp_tuple_keys keys;
+    sp_collect_tuple_keys(joints, significant, vertex_count, k, tuple_index, region, records, &keys);
 
-    uint64_t last_key = 0;
-    uint32_t last_entry = UINT32_MAX;
-    if (!significant) { /* without merging only full-length keys are registered, so equal tuples match */
-        for (size_t v = 0; v < vertex_count; ++v)
-            index_vertex(&b, joints + v * k, k, k, &last_key, &last_entry, tuple_index + v);
-    } else { /* full tuples first, then ever shorter prefixes: a partial tuple finds every full one */
-        for (size_t length = k; length >= 1; --length, last_entry = UINT32_MAX)
-            for (size_t i = start[length]; i < start[length - 1]; ++i)
-                index_vertex(&b, joints + (size_t)order[i] * k, length, 1, &last_key, &last_entry,
-                             tuple_index + order[i]);
+    if (!significant) { /* distinct full tuples, each its own entry in order of first use */
+        for (size_t id = 0; id < keys.size; ++id)
+            memcpy(lut + id * k, joints + (size_t)keys.first[id] * k, k * sizeof(uint16_t));
+        *lut_size = keys.size;
+        return SP_OK;
     }
+    size_t full = table_capacity(keys.size, k);
+    lut_builder b = {lut, 0, k, NULL, NULL, 0, 0, 64, full, region};
+    start_table(&b, FIRST_CAPACITY < full ? FIRST_CAPACITY : full);
+    if (!assign_entries(&b, joints, &keys, entry_of))
+        for (size_t v = 0; v < vertex_count; ++v) tuple_index[v] = entry_of[tuple_index[v]];
     *lut_size = b.size;
     return SP_OK;
 }
