@@ -491,5 +491,6 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
     sp_meshlet_plan_link(&s.plan);
     sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
+    sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live); /* live: all 0, every triangle is out */
     sp_meshlet_plan_write(ctx, &s.plan);
 }
