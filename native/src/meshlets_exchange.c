@@ -19,6 +19,8 @@
  */
 #include "meshlets_internal.h"
 
+#include <string.h>
+
 #define NO_TRIANGLE UINT32_MAX
 #define EXCHANGE_STEPS 16       /* moves per sequence */
 #define EXCHANGE_VERTEX_SLACK 6 /* vertices a meshlet may be over its limit inside a sequence */
@@ -250,9 +252,13 @@ void sp_meshlet_plan_exchange(sp_meshlet_context* ctx, sp_meshlet_plan* plan, co
     pair p;
     uint32_t near[SP_MESHLET_NEIGHBOUR_MAX];
     uint16_t rare[EXCHANGE_RARE_MAX];
-    for (int pass = 0; pass < EXCHANGE_PASSES; ++pass)
+    uint32_t* changed = plan->spatial; /* the pass + 1 that last changed each group; 0: none */
+    memset(changed, 0, plan->count * sizeof(uint32_t));
+    for (uint32_t pass = 0; pass < EXCHANGE_PASSES; ++pass)
         for (uint32_t a = 0; a < plan->count; ++a) {
-            if (plan->merged[a] || !load_pair(ctx, plan, &p, a, NO_GROUP, vertex_local))
+            /* after the first pass only groups the previous pass changed can gain */
+            if (plan->merged[a] || (pass > 0 && changed[a] != pass) ||
+                !load_pair(ctx, plan, &p, a, NO_GROUP, vertex_local))
                 continue;
             uint32_t rare_count = rare_joints(&p, rare), near_count = 0;
             if (rare_count > 0)
@@ -265,8 +271,10 @@ void sp_meshlet_plan_exchange(sp_meshlet_context* ctx, sp_meshlet_plan* plan, co
                     continue;
                 int moved = exchange_pair(ctx, plan, &p);
                 release(ctx, &p, vertex_local);
-                if (moved)
+                if (moved) {
+                    changed[a] = changed[near[k]] = pass + 1;
                     break; /* a changed: its rare joints are found again in the next pass */
+                }
             }
         }
 }

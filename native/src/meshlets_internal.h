@@ -111,7 +111,8 @@ typedef struct sp_meshlet_plan {
     uint32_t* start;          /* meshlet m: order[start[m] .. start[m + 1]) */
     uint32_t* next;           /* next meshlet merged into m's group, or UINT32_MAX */
     uint32_t* tail;           /* last meshlet of m's group */
-    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order */
+    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order (merge), then per group the
+                               * exchange pass that last changed it */
     uint16_t* vertex_count;   /* as closed */
     uint16_t* triangle_count; /* of m's group */
     uint8_t* merged;          /* 1: m went into another meshlet's group */
