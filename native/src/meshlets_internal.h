@@ -111,7 +111,8 @@ typedef struct sp_meshlet_plan {
     uint32_t* start;          /* meshlet m: order[start[m] .. start[m + 1]) */
     uint32_t* next;           /* next meshlet merged into m's group, or UINT32_MAX */
     uint32_t* tail;           /* last meshlet of m's group */
-    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order */
+    uint32_t* spatial;        /* scratch: underfull meshlets in Morton order (merge), then per group the
+                               * exchange pass that last changed it */
     uint16_t* vertex_count;   /* as closed */
     uint16_t* triangle_count; /* of m's group */
     uint8_t* merged;          /* 1: m went into another meshlet's group */
@@ -136,6 +137,20 @@ void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const
 void sp_meshlet_plan_link(sp_meshlet_plan* plan);
 void sp_meshlet_plan_refine(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
                             const uint32_t* vertex_adjacency);
+/* Linked-plan helpers (meshlets_refine.c): the groups other than m (at most
+ * SP_MESHLET_NEIGHBOUR_MAX, into near) that own a triangle around a vertex of the given
+ * triangles; moving triangle t to group b (the caller checked every limit; a group left empty is
+ * marked merged, so it is not written). */
+#define SP_MESHLET_NEIGHBOUR_MAX 32
+uint32_t sp_meshlet_plan_neighbours(const sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m,
+                                    const uint32_t* triangles, uint32_t count, const uint32_t* offset,
+                                    const uint32_t* adjacency, uint32_t* near);
+void sp_meshlet_plan_move_triangle(sp_meshlet_plan* plan, uint32_t t, uint32_t b);
+/* meshlets_exchange.c: between each meshlet and each neighbour, a short sequence of single
+ * triangle moves (either way, a triangle once) that lowers their palette sum, kept up to its best
+ * point within every limit (vertex_local: vertex_count zeros, left zero). */
+void sp_meshlet_plan_exchange(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
+                              const uint32_t* vertex_adjacency, uint32_t* vertex_local);
 /* Writes every group of the linked plan as one meshlet. */
 void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
 

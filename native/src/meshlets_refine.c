@@ -17,7 +17,6 @@
 #include <string.h>
 
 #define NO_TRIANGLE UINT32_MAX
-#define NEIGHBOUR_MAX 32      /* meshlets around one meshlet considered */
 #define REFINE_TRIANGLES 8    /* a joint used by more triangles of its meshlet is not moved */
 #define REFINE_PASSES 2
 
@@ -50,10 +49,9 @@ static void load(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t 
         sp_meshlet_add(ctx, t);
 }
 
-/* The groups other than m that own a triangle around a vertex of the given triangles. */
-static uint32_t neighbours(const sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m,
-                           const uint32_t* triangles, uint32_t count, const uint32_t* offset, const uint32_t* adjacency,
-                           uint32_t* near)
+uint32_t sp_meshlet_plan_neighbours(const sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m,
+                                    const uint32_t* triangles, uint32_t count, const uint32_t* offset,
+                                    const uint32_t* adjacency, uint32_t* near)
 {
     uint32_t found = 0;
     for (uint32_t i = 0; i < count; ++i)
@@ -63,15 +61,14 @@ static uint32_t neighbours(const sp_meshlet_context* ctx, const sp_meshlet_plan*
                 uint32_t o = plan->owner[adjacency[j]], k = 0;
                 while (k < found && near[k] != o)
                     ++k;
-                if (o != m && k == found && found < NEIGHBOUR_MAX)
+                if (o != m && k == found && found < SP_MESHLET_NEIGHBOUR_MAX)
                     near[found++] = o;
             }
         }
     return found;
 }
 
-/* Moves triangle t from its group to group b (the caller checked every limit). */
-static void move_triangle(sp_meshlet_plan* plan, uint32_t t, uint32_t b)
+void sp_meshlet_plan_move_triangle(sp_meshlet_plan* plan, uint32_t t, uint32_t b)
 {
     uint32_t a = plan->owner[t];
     uint32_t* link = &plan->first_triangle[a];
@@ -141,14 +138,14 @@ static int gain_in(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_
 static int evict_joint(sp_meshlet_context* ctx, sp_meshlet_plan* plan, uint32_t a, uint16_t j, uint32_t palette,
                        const uint32_t* offset, const uint32_t* adjacency)
 {
-    uint32_t users[REFINE_TRIANGLES], near[NEIGHBOUR_MAX];
+    uint32_t users[REFINE_TRIANGLES], near[SP_MESHLET_NEIGHBOUR_MAX];
     uint32_t count = joint_users(ctx, plan, a, j, users);
     if (count == 0 || count >= plan->triangle_count[a])
         return 0;
     load_except(ctx, plan, a, users, count);
     int saved = (int)(palette - ctx->open_joint_count); /* at least 1: j leaves a */
     sp_meshlet_reset_open(ctx);
-    uint32_t near_count = neighbours(ctx, plan, a, users, count, offset, adjacency, near);
+    uint32_t near_count = sp_meshlet_plan_neighbours(ctx, plan, a, users, count, offset, adjacency, near);
     int best_change = 0;
     uint32_t best = NO_TRIANGLE;
     for (uint32_t k = 0; k < near_count; ++k) {
@@ -161,7 +158,7 @@ static int evict_joint(sp_meshlet_context* ctx, sp_meshlet_plan* plan, uint32_t 
     if (best == NO_TRIANGLE)
         return 0;
     for (uint32_t i = 0; i < count; ++i)
-        move_triangle(plan, users[i], best);
+        sp_meshlet_plan_move_triangle(plan, users[i], best);
     return 1;
 }
 
