@@ -159,33 +159,26 @@ SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, 
 /* Largest row j with s_N(j) <= w. Estimate from the mirrored square root:
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
- * relevant root is the one left of the apex.) For N < OSS_SMALL_N, inlined into the batch
- * decoder (everything but w is the same for every code of a layer size). */
+ * relevant root is the one left of the apex.) Taken for w + 7/8, as row_estimate in
+ * codec_oss_simd.h: the estimate is then the row in exact arithmetic, so the checks take one
+ * step, not two. For N < OSS_ROW64_N the root's argument is a 64-bit integer ((2N + 1)^2 <
+ * 2^62; its double rounds past 2^53, which moves the estimate by far less than a row) and the
+ * bases are the 64-bit forms (inlined into the batch decoder); past it both are 128-bit. */
 SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
 {
-    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1;
-    /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
-     * arithmetic, so the checks below take one step, not two */
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1; /* (2N + 1)^2 + 3 - 12w >= 0 in the triangle */
     double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
     double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
     return settle_estimate(estimate, rows, n, w, row_base_small, base);
 }
 
-/* The same for N >= OSS_SMALL_N, with the root's argument in 128 bits. */
 static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
 {
     uint64_t rows = (2 * n + 1) / 3;
-    /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
-    sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
-    sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
-    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
-    double estimate = (sp_u128_to_double(two_n1) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (j >= rows) j = rows - 1;
-    while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
-    while (j > 0 && sp_oss_row_base(n, j) > w) --j;
-    *base = sp_oss_row_base(n, j);
-    return j;
+    sp_u128 apex = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1), square = sp_u128_add_u64(sp_u128_mul(apex, apex), 3);
+    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12))) - 10.5;
+    double estimate = (sp_u128_to_double(apex) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    return settle_estimate(estimate, rows, n, w, sp_oss_row_base, base);
 }
 
 /*
@@ -207,41 +200,32 @@ static inline double cube_root_sum(double x)
     return (c + z) + rd * (c * (2.0 / 3.0) + z * (1.0 / 3.0));
 }
 
-/* Largest layer k with u(k) <= code for N < OSS_SMALL_N. The estimate of the vector paths:
- * (2N + 3 - t) / 4 with t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code
- * for code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one
- * check each way, no square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
+/* Largest layer k with u(k) <= code. The estimate of the vector paths: (2N + 3 - t) / 4 with
+ * t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code (M = N + 1) for
+ * code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one check
+ * each way, no square root. With M = N + 1, 72(u~((N+1)/2) - code) is V = 4M^3 + 6M^2 + 16 -
+ * 72 code exactly, and the paper's root is k~ = (2N + 3 - (c + 1/c)) / 4 with
+ * c = cbrt(V - 1 + sqrt(V (V - 2))), c^3 + 1/c^3 = x. x is a 64-bit integer below OSS_SMALL_N
+ * (8M^3 + 12M^2 < 2^64; inlined into the batch decoder), a 128-bit one past it (whose double is
+ * exact enough for an estimate: the root's relative error stays near 1e-8, a fraction of a
+ * layer); the bases are the 64-bit forms below OSS_LAYER64_N, the 128-bit ones past it. */
 SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
 {
-    uint64_t layers = (n + 1) / 2;
-    uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
-    double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
-    double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
+    uint64_t layers = (n + 1) / 2, m = n + 1;
+    uint64_t x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
+    double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? (double)x : 1.0) * 0.25;
     return settle_estimate(estimate, layers, n, code, layer_base_small, base);
 }
 
-/* The same for N >= OSS_SMALL_N. With M = N + 1, 72(u~((N+1)/2) - code) equals
- * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
- * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
 static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
 {
     uint64_t layers = (n + 1) / 2;
-    double v;
-    { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
-        sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
-        sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 4), sp_u128_mul_u64(m2, 6));
-        v = sp_u128_to_double(sp_u128_sub(sp_u128_add_u64(cubic, 16), sp_u128_mul_u64(sp_u128_from(code), 72)));
-    }
-    double root = v > 2 ? sqrt(v * (v - 2)) : 0;
-    double c = cbrt(v - 1 + root);
-    if (c < 1) c = 1;
-    double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
-    uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (k >= layers) k = layers - 1;
-    while (k + 1 < layers && sp_oss_layer_base(n, k + 1) <= code) ++k;
-    while (k > 0 && sp_oss_layer_base(n, k) > code) --k;
-    *base = sp_oss_layer_base(n, k);
-    return k;
+    sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
+    sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 8), sp_u128_mul_u64(m2, 12));
+    double x = sp_u128_to_double(sp_u128_sub(cubic, sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(code), 144), 106)));
+    double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? x : 1.0) * 0.25;
+    return n < OSS_LAYER64_N ? settle_estimate(estimate, layers, n, code, layer_base_small, base)
+                             : settle_estimate(estimate, layers, n, code, sp_oss_layer_base, base);
 }
 
 /* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
@@ -258,7 +242,7 @@ SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
         rest -= base;
         bottom = n - 2 * layer;
     }
-    row = bottom < OSS_SMALL_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
+    row = bottom < OSS_ROW64_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
     uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;

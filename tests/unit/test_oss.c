@@ -44,7 +44,7 @@ static void exhaustive_identity(void)
         }
 }
 
-/* Large N: sampled codes, layer and row boundaries, first and last code, up to 64-bit codes. */
+/* Large N: sampled codes, layer and row boundaries (both sides of the 64-bit forms' limits), first and last code, up to 64-bit codes. */
 static void sampled_identity_large(void)
 {
     for (uint32_t k = 2; k <= 4; ++k)
@@ -59,6 +59,9 @@ static void sampled_identity_large(void)
                 else if (t < 40 && k == 4) { /* around layer starts */
                     uint64_t layer = rng_next() % ((c.n + 1) / 2);
                     code = sp_oss_layer_base(c.n, layer) - (t & 1 ? (layer > 0) : 0);
+                } else if (t < 80 && k == 3) { /* around row starts: the row search's one-step checks */
+                    uint64_t row = rng_next() % ((2 * c.n + 1) / 3);
+                    code = sp_oss_row_base(c.n, row) - (t & 1 ? (row > 0) : 0);
                 } else code = c.max_code == UINT64_MAX ? rng_next() : rng_next() % (c.max_code + 1);
                 uint64_t q[4] = {0};
                 sp_oss_unpack(c.n, k, code, q);
