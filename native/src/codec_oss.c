@@ -142,16 +142,33 @@ void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t fi
     }
 }
 
+/* Codes in row j of the triangle with bottom n, s_n(j + 1) - s_n(j): floor((2n - 3j) / 2). */
+static inline uint64_t row_length(uint64_t n, uint64_t j)
+{
+    return n - j - (j + 1) / 2;
+}
+
+/* Codes in layer k, u(k + 1) - u(k): the triangle of bottom b = n - 2k, (b^2 + b + 1) / 3
+ * (64-bit for b < 2^32, past any N of a 64-bit K = 4 code). */
+static inline uint64_t layer_length(uint64_t n, uint64_t k)
+{
+    uint64_t b = n - 2 * k;
+    return (b * b + b + 1) / 3;
+}
+
 /* The largest index i < count with base_of(n, i) <= w, from an estimate that is it but for
- * rounding: clamped, then one check each way (inlined with base_of, so no indirect call). */
+ * rounding: clamped, one closed form for its base, then steps each way by length_of(n, i) =
+ * base_of(n, i + 1) - base_of(n, i) (one each for the estimates here; inlined with the
+ * functions, so no indirect call, and the 128-bit closed forms of wide codes run once). */
 SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, uint64_t w,
-                                   uint64_t (*base_of)(uint64_t, uint64_t), uint64_t* base)
+                                   uint64_t (*base_of)(uint64_t, uint64_t),
+                                   uint64_t (*length_of)(uint64_t, uint64_t), uint64_t* base)
 {
     uint64_t i = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (i >= count) i = count - 1;
     uint64_t at = base_of(n, i);
-    while (i > 0 && at > w) at = base_of(n, --i);
-    for (uint64_t next; i + 1 < count && (next = base_of(n, i + 1)) <= w; ++i) at = next;
+    while (i > 0 && at > w) at -= length_of(n, --i);
+    for (uint64_t next; i + 1 < count && (next = at + length_of(n, i)) <= w; ++i) at = next; /* next <= max code */
     *base = at;
     return i;
 }
@@ -169,16 +186,23 @@ SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
     uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1; /* (2N + 1)^2 + 3 - 12w >= 0 in the triangle */
     double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
     double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    return settle_estimate(estimate, rows, n, w, row_base_small, base);
+    return settle_estimate(estimate, rows, n, w, row_base_small, row_length, base);
+}
+
+/* A 128-bit integer as a double for an estimate: within 2^-52 of it, not always the nearest
+ * (no call to the compiler's exact conversion). */
+static inline double u128_estimate(sp_u128 a)
+{
+    return (double)sp_u128_high(a) * 18446744073709551616.0 + (double)sp_u128_low(a);
 }
 
 static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
 {
-    uint64_t rows = (2 * n + 1) / 3;
-    sp_u128 apex = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1), square = sp_u128_add_u64(sp_u128_mul(apex, apex), 3);
-    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12))) - 10.5;
-    double estimate = (sp_u128_to_double(apex) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    return settle_estimate(estimate, rows, n, w, sp_oss_row_base, base);
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1; /* n < 2^63 */
+    sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(two_n1), sp_u128_from(two_n1)), 3);
+    double mirrored = u128_estimate(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12))) - 10.5;
+    double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    return settle_estimate(estimate, rows, n, w, sp_oss_row_base, row_length, base);
 }
 
 /*
@@ -214,7 +238,7 @@ SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
     uint64_t layers = (n + 1) / 2, m = n + 1;
     uint64_t x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
     double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? (double)x : 1.0) * 0.25;
-    return settle_estimate(estimate, layers, n, code, layer_base_small, base);
+    return settle_estimate(estimate, layers, n, code, layer_base_small, layer_length, base);
 }
 
 static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
@@ -222,10 +246,10 @@ static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
     uint64_t layers = (n + 1) / 2;
     sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
     sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 8), sp_u128_mul_u64(m2, 12));
-    double x = sp_u128_to_double(sp_u128_sub(cubic, sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(code), 144), 106)));
+    double x = u128_estimate(sp_u128_sub(cubic, sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(code), 144), 106)));
     double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? x : 1.0) * 0.25;
-    return n < OSS_LAYER64_N ? settle_estimate(estimate, layers, n, code, layer_base_small, base)
-                             : settle_estimate(estimate, layers, n, code, sp_oss_layer_base, base);
+    return n < OSS_LAYER64_N ? settle_estimate(estimate, layers, n, code, layer_base_small, layer_length, base)
+                             : settle_estimate(estimate, layers, n, code, sp_oss_layer_base, layer_length, base);
 }
 
 /* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
