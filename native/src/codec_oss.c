@@ -117,17 +117,38 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
     return oss_pack(n, k, q);
 }
 
-/* One vertex after another with k constant, so the rounding and the index unroll into
- * straight-line code with q in registers. */
+/* Vertices per stage of the scalar loops. A vertex's encode or decode is one long dependency
+ * chain (a division or roots, then the closed forms), longer than the core's reorder window
+ * holds a few of, so the loops run in stages (quantise, then index; layers, then rows) over a
+ * chunk: the vertices of a stage are independent, and the core overlaps more of them. */
+#define SCALAR_CHUNK 16
+
+/* Vertices first..count-1 with k constant, so the rounding and the index unroll into
+ * straight-line code; in stages over chunks (SCALAR_CHUNK): the rounding, then the index. */
 SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
                               uint64_t* codes, uint8_t* significant, uint32_t k)
 {
     uint64_t n = codec->n, scale = codec->scale;
-    for (size_t v = first; v < count; ++v) {
-        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-        sp_grid_quantize(weights + v * k, k, scale, q);
-        if (significant) significant[v] = sp_grid_significant(q, k);
-        codes[v] = oss_pack(n, k, q);
+    if (k == 2) { /* short enough a chain without stages */
+        for (size_t v = first; v < count; ++v) {
+            uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+            sp_grid_quantize(weights + v * 2, 2, scale, q);
+            if (significant) significant[v] = sp_grid_significant(q, 2);
+            codes[v] = oss_pack(n, 2, q);
+        }
+        return;
+    }
+    for (size_t v = first; v < count; v += SCALAR_CHUNK) {
+        uint64_t q[SCALAR_CHUNK][SP_MAX_INFLUENCES];
+        size_t chunk = count - v < SCALAR_CHUNK ? count - v : SCALAR_CHUNK;
+        for (size_t c = 0; c < chunk; ++c) {
+            q[c][1] = q[c][2] = q[c][3] = 0;
+            sp_grid_quantize(weights + (v + c) * k, k, scale, q[c]);
+        }
+        for (size_t c = 0; c < chunk; ++c) {
+            if (significant) significant[v + c] = sp_grid_significant(q[c], k);
+            codes[v + c] = oss_pack(n, k, q[c]);
+        }
     }
 }
 
@@ -252,26 +273,37 @@ static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
                              : settle_estimate(estimate, layers, n, code, sp_oss_layer_base, layer_length, base);
 }
 
-/* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
-SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+/* The layer of a K = 4 code and its index inside the layer (sp_oss_unpack's first half). */
+SP_INLINE uint64_t unpack_layer(uint64_t n, uint64_t code, uint64_t* rest)
 {
-    uint64_t layer = 0, row, rest = code, bottom = n, base;
-    if (k == 2) {
-        q[1] = code;
-        q[0] = 2 * (n - 1) - code;
-        return;
-    }
-    if (k == 4) {
-        layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
-        rest -= base;
-        bottom = n - 2 * layer;
-    }
-    row = bottom < OSS_ROW64_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
+    uint64_t base, layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
+    *rest = code - base;
+    return layer;
+}
+
+/* Sorted grid coordinates (K = 3, 4) from the layer (0 for K = 3) and the index inside it. */
+SP_INLINE void unpack_rows(uint64_t n, uint32_t k, uint64_t layer, uint64_t rest, uint64_t* q)
+{
+    uint64_t base, bottom = n - 2 * layer;
+    uint64_t row = bottom < OSS_ROW64_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
     uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;
     q[1] = i + row + layer;
     q[0] = 2 * (n - 1) - q[1] - q[2] - (k == 4 ? q[3] : 0);
+}
+
+/* Grid coordinates of a code, inlined with a constant k. */
+SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+{
+    uint64_t layer = 0, rest = code;
+    if (k == 2) {
+        q[1] = code;
+        q[0] = 2 * (n - 1) - code;
+        return;
+    }
+    if (k == 4) layer = unpack_layer(n, code, &rest);
+    unpack_rows(n, k, layer, rest, q);
 }
 
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
@@ -285,11 +317,30 @@ SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, si
 {
     uint64_t n = codec->n, max_code = codec->max_code;
     double inverse = 1.0 / (double)codec->scale; /* as sp_grid_to_weights */
-    for (size_t v = first; v < count; ++v) {
-        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-        if (codes[v] > max_code) return v;
-        oss_unpack(n, k, codes[v], q);
-        for (uint32_t i = 0; i < k; ++i) weights[v * k + i] = (float)((double)q[i] * inverse);
+    if (k == 2) { /* a subtraction: no chain to break up */
+        for (size_t v = first; v < count; ++v) {
+            if (codes[v] > max_code) return v;
+            weights[v * 2] = (float)((double)(2 * (n - 1) - codes[v]) * inverse);
+            weights[v * 2 + 1] = (float)((double)codes[v] * inverse);
+        }
+        return count;
+    }
+    for (size_t v = first; v < count;) {
+        uint64_t layer[SCALAR_CHUNK], rest[SCALAR_CHUNK];
+        size_t end = count - v < SCALAR_CHUNK ? count : v + SCALAR_CHUNK, valid = v;
+        while (valid < end && codes[valid] <= max_code) ++valid;
+        for (size_t c = 0; c < valid - v; ++c) {
+            layer[c] = 0, rest[c] = codes[v + c];
+            if (k == 4) layer[c] = unpack_layer(n, rest[c], &rest[c]);
+        }
+        for (size_t c = 0; c < valid - v; ++c) {
+            uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+            unpack_rows(n, k, layer[c], rest[c], q);
+            SP_UNROLL
+            for (uint32_t i = 0; i < k; ++i) weights[(v + c) * k + i] = (float)((double)q[i] * inverse);
+        }
+        if (valid < end) return valid;
+        v = end;
     }
     return count;
 }
