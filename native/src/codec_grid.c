@@ -3,6 +3,9 @@
  * with OSS. All four place the weights on the integer grid q/s with q summing to s, so the
  * decoded tuple is sorted, non-negative and sums to exactly one.
  */
+#include <float.h>
+#include <string.h>
+
 #include "codec_internal.h"
 
 /* Slot order by descending remainder, ties to the lower slot (stable insertion sort). */
@@ -18,6 +21,25 @@ SP_INLINE void order_by_remainder(const double* remainder, uint32_t k, uint32_t*
     }
 }
 
+/* floor(x) of 0 <= x < 2^64 in long double. Where long double is the x87 80-bit format, C's
+ * conversion switches the x87 rounding mode twice (fnstcw/fldcw, which stall the pipeline: most
+ * of the time of K = 2 codes past 50 bits); instead the bits: x = significand 2^(e - 63) with an
+ * explicit 64-bit significand, so floor(x) is the significand shifted right by 63 - e (0 for
+ * x < 1, e < 0). */
+SP_INLINE uint64_t floor_long_double(long double x)
+{
+#if (defined(__x86_64__) || defined(__i386__)) && LDBL_MANT_DIG == 64
+    uint64_t significand;
+    uint16_t sign_exponent;
+    memcpy(&significand, &x, sizeof(significand)); /* little endian: significand, then sign and exponent */
+    memcpy(&sign_exponent, (const unsigned char*)&x + 8, sizeof(sign_exponent));
+    int e = (int)(sign_exponent & 0x7FFF) - 16383; /* <= 63 for x < 2^64 */
+    return e < 0 ? 0 : significand >> (63 - e);
+#else
+    return (uint64_t)x;
+#endif
+}
+
 /* floor(x) for 0 <= x, clamped to [0, limit] (NaN to 0); long double keeps all 64 bits of large
  * grids. Selects, not branches: zero weights come in no predictable order. */
 SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
@@ -25,7 +47,7 @@ SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainde
     long double top = (long double)limit;
     x = x > 0 ? x : 0;
     x = x < top ? x : top;
-    uint64_t f = (uint64_t)x;
+    uint64_t f = floor_long_double(x);
     *remainder = (double)(x - (long double)f);
     return f;
 }
