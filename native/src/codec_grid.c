@@ -91,10 +91,33 @@ SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, ui
         }
 }
 
+/* quantize_general for k = 2, what OSS codes of 51..64 bits (grids past 2^50) take per vertex:
+ * the same floors, and for a deficit d (s - q0 - q1 >= 0) the same d/2 each and the odd one to
+ * the larger remainder (ties to slot 0), as selects: d is 0 or 1 at random, which a branch
+ * mispredicts. A sum past s (degenerate input) takes the general code. */
+SP_INLINE void quantize_pair(const float* weights, uint64_t s, uint64_t* q)
+{
+    double remainder[2], sum = 0;
+    sum += weights[0]; /* the general code's order of additions */
+    sum += weights[1];
+    if (!(sum > 0)) sum = 1;
+    long double scale = (long double)s / (long double)sum;
+    uint64_t q0 = floor_clamped((long double)weights[0] * scale, s, &remainder[0]);
+    uint64_t q1 = floor_clamped((long double)weights[1] * scale, s, &remainder[1]);
+    if (q0 > s - q1) { /* q0 + q1 > s (q1 <= s) */
+        quantize_general(weights, 2, s, q);
+        return;
+    }
+    uint64_t deficit = s - q0 - q1, odd = deficit & 1, to_second = remainder[0] < remainder[1];
+    q0 += deficit / 2 + (odd & (to_second ^ 1));
+    q1 += deficit / 2 + (odd & to_second);
+    q[0] = q0 > q1 ? q0 : q1; /* descending, as the general code's final sort */
+    q[1] = q0 > q1 ? q1 : q0;
+}
+
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
-    /* K = 2 with a constant k: what OSS codes of 51..64 bits (grids past 2^50) take per vertex */
-    if (k == 2) quantize_general(weights, 2, s, q);
+    if (k == 2) quantize_pair(weights, s, q);
     else quantize_general(weights, k, s, q);
 }
 
