@@ -12,9 +12,10 @@
 
 #include "codec_internal.h"
 
-/* Below OSS_SMALL_N the decoder's 64-bit root arguments are exact (8(N + 1)^3 < 2^64). Below
- * OSS_ROW64_N and OSS_LAYER64_N the closed forms' numerators fit in 64 bits, so the 64-bit forms
- * are exact: 4jN + 2j + 1 < 2^62 + 2^31 for rows j, N < 2^30; 3Nk(N - 2k + 3) <= 3N^3/8 and
+/* Below OSS_SMALL_N the decoder's layer root argument 8(N + 1)^3 + ... is exact in 64 bits;
+ * below OSS_ROW64_N so is its row root argument (2N + 1)^2 + 3 - 12w < 2^62. Below OSS_ROW64_N
+ * and OSS_LAYER64_N the closed forms' numerators fit in 64 bits, so the 64-bit forms are exact:
+ * 4jN + 2j + 1 < 2^62 + 2^31 for rows j, N < 2^30; 3Nk(N - 2k + 3) <= 3N^3/8 and
  * k(4k^2 - 9k + 6) < 4k^3 for layers k <= (N + 1)/2, below 2^63 for N < 2^21. */
 #define OSS_SMALL_N ((uint64_t)1 << 20)
 #define OSS_ROW64_N ((uint64_t)1 << 30)
