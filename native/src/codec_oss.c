@@ -120,7 +120,7 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 
 /* One vertex after another with k constant, so the rounding and the index unroll into
  * straight-line code with q in registers. (Not in stages as the decoder: the staged form ran
- * ~20 % more instructions, and ~10 % slower on a quiet core.) */
+ * ~3 % more instructions and was no faster at its best.) */
 SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
                               uint64_t* codes, uint8_t* significant, uint32_t k)
 {
