@@ -73,6 +73,11 @@ uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
     if (n < OSS_LAYER64_N) return layer_base_small(n, k);
+    if (n < OSS_ROW64_N) { /* 3Nk < 2^61 and 4k^2 - 9k + 6 < 2^60 in 64 bits: two 64 x 64-bit products */
+        sp_u128 outer = sp_u128_mul(sp_u128_from(3 * n * k), sp_u128_from(n - 2 * k + 3));
+        sp_u128 inner = sp_u128_mul(sp_u128_from(k), sp_u128_from(4 * k * k - 9 * k + 6));
+        return u128_div_small(sp_u128_add_u64(sp_u128_add(outer, inner), 2), 9);
+    }
     return u128_div_small(layer_numerator(n, k), 9);
 }
 
