@@ -3,6 +3,9 @@
  * with OSS. All four place the weights on the integer grid q/s with q summing to s, so the
  * decoded tuple is sorted, non-negative and sums to exactly one.
  */
+#include <float.h>
+#include <string.h>
+
 #include "codec_internal.h"
 
 /* Slot order by descending remainder, ties to the lower slot (stable insertion sort). */
@@ -18,6 +21,25 @@ SP_INLINE void order_by_remainder(const double* remainder, uint32_t k, uint32_t*
     }
 }
 
+/* floor(x) of 0 <= x < 2^64 in long double. Where long double is the x87 80-bit format, C's
+ * conversion switches the x87 rounding mode twice (fnstcw/fldcw, which stall the pipeline: most
+ * of the time of K = 2 codes past 50 bits); instead the bits: x = significand 2^(e - 63) with an
+ * explicit 64-bit significand, so floor(x) is the significand shifted right by 63 - e (0 for
+ * x < 1, e < 0). */
+SP_INLINE uint64_t floor_long_double(long double x)
+{
+#if (defined(__x86_64__) || defined(__i386__)) && LDBL_MANT_DIG == 64
+    uint64_t significand;
+    uint16_t sign_exponent;
+    memcpy(&significand, &x, sizeof(significand)); /* little endian: significand, then sign and exponent */
+    memcpy(&sign_exponent, (const unsigned char*)&x + 8, sizeof(sign_exponent));
+    int e = (int)(sign_exponent & 0x7FFF) - 16383; /* <= 63 for x < 2^64 */
+    return e < 0 ? 0 : significand >> (63 - e);
+#else
+    return (uint64_t)x;
+#endif
+}
+
 /* floor(x) for 0 <= x, clamped to [0, limit] (NaN to 0); long double keeps all 64 bits of large
  * grids. Selects, not branches: zero weights come in no predictable order. */
 SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainder)
@@ -25,7 +47,7 @@ SP_INLINE uint64_t floor_clamped(long double x, uint64_t limit, double* remainde
     long double top = (long double)limit;
     x = x > 0 ? x : 0;
     x = x < top ? x : top;
-    uint64_t f = (uint64_t)x;
+    uint64_t f = floor_long_double(x);
     *remainder = (double)(x - (long double)f);
     return f;
 }
@@ -69,10 +91,33 @@ SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, ui
         }
 }
 
+/* quantize_general for k = 2, what OSS codes of 51..64 bits (grids past 2^50) take per vertex:
+ * the same floors, and for a deficit d (s - q0 - q1 >= 0) the same d/2 each and the odd one to
+ * the larger remainder (ties to slot 0), as selects: d is 0 or 1 at random, which a branch
+ * mispredicts. A sum past s (degenerate input) takes the general code. */
+SP_INLINE void quantize_pair(const float* weights, uint64_t s, uint64_t* q)
+{
+    double remainder[2], sum = 0;
+    sum += weights[0]; /* the general code's order of additions */
+    sum += weights[1];
+    if (!(sum > 0)) sum = 1;
+    long double scale = (long double)s / (long double)sum;
+    uint64_t q0 = floor_clamped((long double)weights[0] * scale, s, &remainder[0]);
+    uint64_t q1 = floor_clamped((long double)weights[1] * scale, s, &remainder[1]);
+    if (q0 > s - q1) { /* q0 + q1 > s (q1 <= s) */
+        quantize_general(weights, 2, s, q);
+        return;
+    }
+    uint64_t deficit = s - q0 - q1, odd = deficit & 1, to_second = remainder[0] < remainder[1];
+    q0 += deficit / 2 + (odd & (to_second ^ 1));
+    q1 += deficit / 2 + (odd & to_second);
+    q[0] = q0 > q1 ? q0 : q1; /* descending, as the general code's final sort */
+    q[1] = q0 > q1 ? q1 : q0;
+}
+
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
-    /* K = 2 with a constant k: what OSS codes of 51..64 bits (grids past 2^50) take per vertex */
-    if (k == 2) quantize_general(weights, 2, s, q);
+    if (k == 2) quantize_pair(weights, s, q);
     else quantize_general(weights, k, s, q);
 }
 

@@ -12,9 +12,10 @@
 
 #include "codec_internal.h"
 
-/* Below OSS_SMALL_N the decoder's 64-bit root arguments are exact (8(N + 1)^3 < 2^64). Below
- * OSS_ROW64_N and OSS_LAYER64_N the closed forms' numerators fit in 64 bits, so the 64-bit forms
- * are exact: 4jN + 2j + 1 < 2^62 + 2^31 for rows j, N < 2^30; 3Nk(N - 2k + 3) <= 3N^3/8 and
+/* Below OSS_SMALL_N the decoder's layer root argument 8(N + 1)^3 + ... is exact in 64 bits;
+ * below OSS_ROW64_N so is its row root argument (2N + 1)^2 + 3 - 12w < 2^62. Below OSS_ROW64_N
+ * and OSS_LAYER64_N the closed forms' numerators fit in 64 bits, so the 64-bit forms are exact:
+ * 4jN + 2j + 1 < 2^62 + 2^31 for rows j, N < 2^30; 3Nk(N - 2k + 3) <= 3N^3/8 and
  * k(4k^2 - 9k + 6) < 4k^3 for layers k <= (N + 1)/2, below 2^63 for N < 2^21. */
 #define OSS_SMALL_N ((uint64_t)1 << 20)
 #define OSS_ROW64_N ((uint64_t)1 << 30)
@@ -72,6 +73,11 @@ uint64_t sp_oss_layer_base(uint64_t n, uint64_t k)
 {
     /* floor((3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2) / 9), Appendix C. */
     if (n < OSS_LAYER64_N) return layer_base_small(n, k);
+    if (n < OSS_ROW64_N) { /* 3Nk < 2^61 and 4k^2 - 9k + 6 < 2^60 in 64 bits: two 64 x 64-bit products */
+        sp_u128 outer = sp_u128_mul(sp_u128_from(3 * n * k), sp_u128_from(n - 2 * k + 3));
+        sp_u128 inner = sp_u128_mul(sp_u128_from(k), sp_u128_from(4 * k * k - 9 * k + 6));
+        return u128_div_small(sp_u128_add_u64(sp_u128_add(outer, inner), 2), 9);
+    }
     return u128_div_small(layer_numerator(n, k), 9);
 }
 
@@ -118,7 +124,8 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
 }
 
 /* One vertex after another with k constant, so the rounding and the index unroll into
- * straight-line code with q in registers. */
+ * straight-line code with q in registers. (Not in stages as the decoder: the staged form ran
+ * ~3 % more instructions and was no faster at its best.) */
 SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
                               uint64_t* codes, uint8_t* significant, uint32_t k)
 {
@@ -142,16 +149,33 @@ void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t fi
     }
 }
 
+/* Codes in row j of the triangle with bottom n, s_n(j + 1) - s_n(j): floor((2n - 3j) / 2). */
+static inline uint64_t row_length(uint64_t n, uint64_t j)
+{
+    return n - j - (j + 1) / 2;
+}
+
+/* Codes in layer k, u(k + 1) - u(k): the triangle of bottom b = n - 2k, (b^2 + b + 1) / 3
+ * (64-bit for b < 2^32, past any N of a 64-bit K = 4 code). */
+static inline uint64_t layer_length(uint64_t n, uint64_t k)
+{
+    uint64_t b = n - 2 * k;
+    return (b * b + b + 1) / 3;
+}
+
 /* The largest index i < count with base_of(n, i) <= w, from an estimate that is it but for
- * rounding: clamped, then one check each way (inlined with base_of, so no indirect call). */
+ * rounding: clamped, one closed form for its base, then steps each way by length_of(n, i) =
+ * base_of(n, i + 1) - base_of(n, i) (one each for the estimates here; inlined with the
+ * functions, so no indirect call, and the 128-bit closed forms of wide codes run once). */
 SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, uint64_t w,
-                                   uint64_t (*base_of)(uint64_t, uint64_t), uint64_t* base)
+                                   uint64_t (*base_of)(uint64_t, uint64_t),
+                                   uint64_t (*length_of)(uint64_t, uint64_t), uint64_t* base)
 {
     uint64_t i = estimate <= 0 ? 0 : (uint64_t)estimate;
     if (i >= count) i = count - 1;
     uint64_t at = base_of(n, i);
-    while (i > 0 && at > w) at = base_of(n, --i);
-    for (uint64_t next; i + 1 < count && (next = base_of(n, i + 1)) <= w; ++i) at = next;
+    while (i > 0 && at > w) at -= length_of(n, --i);
+    for (uint64_t next; i + 1 < count && (next = at + length_of(n, i)) <= w; ++i) at = next; /* next <= max code */
     *base = at;
     return i;
 }
@@ -159,33 +183,33 @@ SP_INLINE uint64_t settle_estimate(double estimate, uint64_t count, uint64_t n, 
 /* Largest row j with s_N(j) <= w. Estimate from the mirrored square root:
  * s~(j*) - s~(j) = 3/4 (j* - j)^2 with j* = (2N+1)/3, and 12(s~(j*) - w) = (2N+1)^2 + 3 - 12w
  * exactly, so j~ = (2N + 1 - sqrt((2N+1)^2 + 3 - 12w)) / 3. (The paper prints "+ sqrt"; the
- * relevant root is the one left of the apex.) For N < OSS_SMALL_N, inlined into the batch
- * decoder (everything but w is the same for every code of a layer size). */
+ * relevant root is the one left of the apex.) Taken for w + 7/8, as row_estimate in
+ * codec_oss_simd.h: the estimate is then the row in exact arithmetic, so the checks take one
+ * step, not two. For N < OSS_ROW64_N the root's argument is a 64-bit integer ((2N + 1)^2 <
+ * 2^62; its double rounds past 2^53, which moves the estimate by far less than a row) and the
+ * bases are the 64-bit forms (inlined into the batch decoder); past it both are 128-bit. */
 SP_INLINE uint64_t find_row_small(uint64_t n, uint64_t w, uint64_t* base)
 {
-    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1;
-    /* for w + 7/8, as row_estimate in codec_oss_simd.h: the estimate is then the row in exact
-     * arithmetic, so the checks below take one step, not two */
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1; /* (2N + 1)^2 + 3 - 12w >= 0 in the triangle */
     double mirrored = (double)(int64_t)(two_n1 * two_n1 + 3 - 12 * w) - 10.5;
     double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    return settle_estimate(estimate, rows, n, w, row_base_small, base);
+    return settle_estimate(estimate, rows, n, w, row_base_small, row_length, base);
 }
 
-/* The same for N >= OSS_SMALL_N, with the root's argument in 128 bits. */
+/* A 128-bit integer as a double for an estimate: within 2^-52 of it, not always the nearest
+ * (no call to the compiler's exact conversion). */
+static inline double u128_estimate(sp_u128 a)
+{
+    return (double)sp_u128_high(a) * 18446744073709551616.0 + (double)sp_u128_low(a);
+}
+
 static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
 {
-    uint64_t rows = (2 * n + 1) / 3;
-    /* (2N + 1)^2 + 3 - 12w > 0 for the codes of the triangle */
-    sp_u128 two_n1 = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(n), 2), 1);
-    sp_u128 square = sp_u128_add_u64(sp_u128_mul(two_n1, two_n1), 3);
-    double mirrored = sp_u128_to_double(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12)));
-    double estimate = (sp_u128_to_double(two_n1) - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
-    uint64_t j = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (j >= rows) j = rows - 1;
-    while (j + 1 < rows && sp_oss_row_base(n, j + 1) <= w) ++j;
-    while (j > 0 && sp_oss_row_base(n, j) > w) --j;
-    *base = sp_oss_row_base(n, j);
-    return j;
+    uint64_t rows = (2 * n + 1) / 3, two_n1 = 2 * n + 1; /* n < 2^63 */
+    sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(two_n1), sp_u128_from(two_n1)), 3);
+    double mirrored = u128_estimate(sp_u128_sub(square, sp_u128_mul_u64(sp_u128_from(w), 12))) - 10.5;
+    double estimate = ((double)two_n1 - sqrt(mirrored > 0 ? mirrored : 0)) * (1.0 / 3.0);
+    return settle_estimate(estimate, rows, n, w, sp_oss_row_base, row_length, base);
 }
 
 /*
@@ -207,58 +231,47 @@ static inline double cube_root_sum(double x)
     return (c + z) + rd * (c * (2.0 / 3.0) + z * (1.0 / 3.0));
 }
 
-/* Largest layer k with u(k) <= code for N < OSS_SMALL_N. The estimate of the vector paths:
- * (2N + 3 - t) / 4 with t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code
- * for code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one
- * check each way, no square root. x is exact in 64 bits (8M^3 + 12M^2 < 2^64). */
+/* Largest layer k with u(k) <= code. The estimate of the vector paths: (2N + 3 - t) / 4 with
+ * t = cbrt(x) + 1/cbrt(x), x = 2(V - 1) = 8M^3 + 12M^2 - 106 - 144 code (M = N + 1) for
+ * code + 17/18, which puts every code strictly inside its layer (see codec_oss_simd.h): one check
+ * each way, no square root. With M = N + 1, 72(u~((N+1)/2) - code) is V = 4M^3 + 6M^2 + 16 -
+ * 72 code exactly, and the paper's root is k~ = (2N + 3 - (c + 1/c)) / 4 with
+ * c = cbrt(V - 1 + sqrt(V (V - 2))), c^3 + 1/c^3 = x. x is a 64-bit integer below OSS_SMALL_N
+ * (8M^3 + 12M^2 < 2^64; inlined into the batch decoder), a 128-bit one past it (whose double is
+ * exact enough for an estimate: the root's relative error stays near 1e-8, a fraction of a
+ * layer); the bases are the 64-bit forms below OSS_LAYER64_N, the 128-bit ones past it. */
 SP_INLINE uint64_t find_layer_small(uint64_t n, uint64_t code, uint64_t* base)
 {
-    uint64_t layers = (n + 1) / 2;
-    uint64_t m = n + 1, x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
-    double t = cube_root_sum(x >= 1 ? (double)x : 1.0);
-    double estimate = (double)(2 * n + 3) * 0.25 - t * 0.25;
-    return settle_estimate(estimate, layers, n, code, layer_base_small, base);
+    uint64_t layers = (n + 1) / 2, m = n + 1;
+    uint64_t x = 8 * m * m * m + 12 * m * m - 106 - 144 * code; /* >= 6 for valid codes */
+    double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? (double)x : 1.0) * 0.25;
+    return settle_estimate(estimate, layers, n, code, layer_base_small, layer_length, base);
 }
 
-/* The same for N >= OSS_SMALL_N. With M = N + 1, 72(u~((N+1)/2) - code) equals
- * V = 4M^3 + 6M^2 + 16 - 72 code exactly, and the paper's root is
- * k~ = (2N + 3 - (c + 1/c)) / 4 with c = cbrt(V - 1 + sqrt(V (V - 2))). */
 static uint64_t find_layer_wide(uint64_t n, uint64_t code, uint64_t* base)
 {
     uint64_t layers = (n + 1) / 2;
-    double v;
-    { /* 4M^3 + 6M^2 + 16 - 72 code, positive for the codes of the tetrahedron */
-        sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
-        sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 4), sp_u128_mul_u64(m2, 6));
-        v = sp_u128_to_double(sp_u128_sub(sp_u128_add_u64(cubic, 16), sp_u128_mul_u64(sp_u128_from(code), 72)));
-    }
-    double root = v > 2 ? sqrt(v * (v - 2)) : 0;
-    double c = cbrt(v - 1 + root);
-    if (c < 1) c = 1;
-    double estimate = (2.0 * (double)n + 3.0 - (c + 1.0 / c)) / 4.0;
-    uint64_t k = estimate <= 0 ? 0 : (uint64_t)estimate;
-    if (k >= layers) k = layers - 1;
-    while (k + 1 < layers && sp_oss_layer_base(n, k + 1) <= code) ++k;
-    while (k > 0 && sp_oss_layer_base(n, k) > code) --k;
-    *base = sp_oss_layer_base(n, k);
-    return k;
+    sp_u128 m = sp_u128_from(n + 1), m2 = sp_u128_mul(m, m);
+    sp_u128 cubic = sp_u128_add(sp_u128_mul_u64(sp_u128_mul(m2, m), 8), sp_u128_mul_u64(m2, 12));
+    double x = u128_estimate(sp_u128_sub(cubic, sp_u128_add_u64(sp_u128_mul_u64(sp_u128_from(code), 144), 106)));
+    double estimate = (double)(2 * n + 3) * 0.25 - cube_root_sum(x >= 1 ? x : 1.0) * 0.25;
+    return n < OSS_LAYER64_N ? settle_estimate(estimate, layers, n, code, layer_base_small, layer_length, base)
+                             : settle_estimate(estimate, layers, n, code, sp_oss_layer_base, layer_length, base);
 }
 
-/* Grid coordinates of a code, inlined into the batch decoder with a constant k. */
-SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+/* The layer of a K = 4 code and its index inside the layer (sp_oss_unpack's first half). */
+SP_INLINE uint64_t unpack_layer(uint64_t n, uint64_t code, uint64_t* rest)
 {
-    uint64_t layer = 0, row, rest = code, bottom = n, base;
-    if (k == 2) {
-        q[1] = code;
-        q[0] = 2 * (n - 1) - code;
-        return;
-    }
-    if (k == 4) {
-        layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
-        rest -= base;
-        bottom = n - 2 * layer;
-    }
-    row = bottom < OSS_SMALL_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
+    uint64_t base, layer = n < OSS_SMALL_N ? find_layer_small(n, code, &base) : find_layer_wide(n, code, &base);
+    *rest = code - base;
+    return layer;
+}
+
+/* Sorted grid coordinates (K = 3, 4) from the layer (0 for K = 3) and the index inside it. */
+SP_INLINE void unpack_rows(uint64_t n, uint32_t k, uint64_t layer, uint64_t rest, uint64_t* q)
+{
+    uint64_t base, bottom = n - 2 * layer;
+    uint64_t row = bottom < OSS_ROW64_N ? find_row_small(bottom, rest, &base) : find_row_wide(bottom, rest, &base);
     uint64_t i = rest - base;
     if (k == 4) q[3] = layer;
     q[2] = row + layer;
@@ -266,10 +279,29 @@ SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
     q[0] = 2 * (n - 1) - q[1] - q[2] - (k == 4 ? q[3] : 0);
 }
 
+/* Grid coordinates of a code, inlined with a constant k. */
+SP_INLINE void oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
+{
+    uint64_t layer = 0, rest = code;
+    if (k == 2) {
+        q[1] = code;
+        q[0] = 2 * (n - 1) - code;
+        return;
+    }
+    if (k == 4) layer = unpack_layer(n, code, &rest);
+    unpack_rows(n, k, layer, rest, q);
+}
+
 void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
 {
     oss_unpack(n, k, code, q);
 }
+
+/* Codes per stage of the scalar decoder. A K = 3, 4 decode is one long dependency chain (a
+ * cube root and a layer base, then a square root and a row base), longer than the core's
+ * reorder window holds a few of, so the decoder runs in stages (layers, then rows) over a chunk:
+ * the codes of a stage are independent, and the core overlaps more of them. */
+#define SCALAR_CHUNK 16
 
 /* Decodes codes first..count-1 with k constant; stops at a code past the codec's range. */
 SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count,
@@ -277,11 +309,30 @@ SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, si
 {
     uint64_t n = codec->n, max_code = codec->max_code;
     double inverse = 1.0 / (double)codec->scale; /* as sp_grid_to_weights */
-    for (size_t v = first; v < count; ++v) {
-        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-        if (codes[v] > max_code) return v;
-        oss_unpack(n, k, codes[v], q);
-        for (uint32_t i = 0; i < k; ++i) weights[v * k + i] = (float)((double)q[i] * inverse);
+    if (k == 2) { /* a subtraction: no chain to break up */
+        for (size_t v = first; v < count; ++v) {
+            if (codes[v] > max_code) return v;
+            weights[v * 2] = (float)((double)(2 * (n - 1) - codes[v]) * inverse);
+            weights[v * 2 + 1] = (float)((double)codes[v] * inverse);
+        }
+        return count;
+    }
+    for (size_t v = first; v < count;) {
+        uint64_t layer[SCALAR_CHUNK], rest[SCALAR_CHUNK];
+        size_t end = count - v < SCALAR_CHUNK ? count : v + SCALAR_CHUNK, valid = v;
+        while (valid < end && codes[valid] <= max_code) ++valid;
+        for (size_t c = 0; c < valid - v; ++c) {
+            layer[c] = 0, rest[c] = codes[v + c];
+            if (k == 4) layer[c] = unpack_layer(n, rest[c], &rest[c]);
+        }
+        for (size_t c = 0; c < valid - v; ++c) {
+            uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+            unpack_rows(n, k, layer[c], rest[c], q);
+            SP_UNROLL
+            for (uint32_t i = 0; i < k; ++i) weights[(v + c) * k + i] = (float)((double)q[i] * inverse);
+        }
+        if (valid < end) return valid;
+        v = end;
     }
     return count;
 }

@@ -25,6 +25,27 @@ static void closed_forms_match_iteration(void)
     CHECK(sp_oss_tetrahedron_count(421) == 4189921);
 }
 
+/* Large N on both sides of the 64-bit forms' limits (layers 2^21, rows and the two-product
+ * layer form 2^30): consecutive bases differ by the layer's triangle and the row's length, from
+ * 0. Layers only while u(k + 1) < 2^64 (every k below 2^23, a few past it). */
+static void closed_forms_wide(void)
+{
+    static const uint64_t sizes[] = {(1u << 21) - 1, 1u << 21, (1u << 21) + 1, 6924641, (1u << 30) - 1, 1u << 30,
+                                     (1u << 30) + 1};
+    for (size_t s = 0; s < sizeof(sizes) / sizeof(sizes[0]); ++s) {
+        uint64_t n = sizes[s], layers = (n + 1) / 2, rows = (2 * n + 1) / 3;
+        uint64_t probes[] = {0, 1, 2, 3, 5, n < (1u << 23) ? layers / 2 : 6, n < (1u << 23) ? layers - 2 : 7};
+        CHECK(sp_oss_layer_base(n, 0) == 0 && sp_oss_row_base(n, 0) == 0);
+        for (size_t p = 0; p < sizeof(probes) / sizeof(probes[0]); ++p) {
+            uint64_t k = probes[p], j = p < 5 ? probes[p] : (p == 5 ? rows / 2 : rows - 2);
+            CHECK_MSG(sp_oss_layer_base(n, k + 1) - sp_oss_layer_base(n, k) == sp_oss_triangle_count(n - 2 * k),
+                      "u(k) N=%llu k=%llu", (unsigned long long)n, (unsigned long long)k);
+            CHECK_MSG(sp_oss_row_base(n, j + 1) - sp_oss_row_base(n, j) == n - j - (j + 1) / 2, "s(j) N=%llu j=%llu",
+                      (unsigned long long)n, (unsigned long long)j);
+        }
+    }
+}
+
 /* Every code decodes to a valid tuple and encodes back to itself. */
 static void exhaustive_identity(void)
 {
@@ -44,7 +65,7 @@ static void exhaustive_identity(void)
         }
 }
 
-/* Large N: sampled codes, layer and row boundaries, first and last code, up to 64-bit codes. */
+/* Large N: sampled codes, layer and row boundaries (both sides of the 64-bit forms' limits), first and last code, up to 64-bit codes. */
 static void sampled_identity_large(void)
 {
     for (uint32_t k = 2; k <= 4; ++k)
@@ -59,6 +80,9 @@ static void sampled_identity_large(void)
                 else if (t < 40 && k == 4) { /* around layer starts */
                     uint64_t layer = rng_next() % ((c.n + 1) / 2);
                     code = sp_oss_layer_base(c.n, layer) - (t & 1 ? (layer > 0) : 0);
+                } else if (t < 80 && k == 3) { /* around row starts: the row search's one-step checks */
+                    uint64_t row = rng_next() % ((2 * c.n + 1) / 3);
+                    code = sp_oss_row_base(c.n, row) - (t & 1 ? (row > 0) : 0);
                 } else code = c.max_code == UINT64_MAX ? rng_next() : rng_next() % (c.max_code + 1);
                 uint64_t q[4] = {0};
                 sp_oss_unpack(c.n, k, code, q);
@@ -70,6 +94,7 @@ static void sampled_identity_large(void)
 int main(void)
 {
     closed_forms_match_iteration();
+    closed_forms_wide();
     exhaustive_identity();
     sampled_identity_large();
     return check_report("test_oss");
