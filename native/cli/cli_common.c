@@ -136,15 +136,8 @@ static void summarize_meshlets(const sp_packed_meshlets* v, cli_meshlet_summary*
     summary->local_tuple_bits_mean = entries ? tuple_bits_sum / (double)entries : 0;
 }
 
-static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
-                         uint32_t words_per_vertex, size_t primitive_vertex_count, const uint16_t* lut, size_t lut_size,
-                         size_t skin_joint_count, const sp_packed_meshlets* meshlets, cli_decoded_skin* out,
-                         char* err, size_t err_size) {
-    memset(out, 0, sizeof(*out));
-    /* Every format rule is the library's (sp_validate_packed); this only passes what the file says. */
-    sp_packed_primitive primitive;
-    memset(&primitive, 0, sizeof(primitive));
-    sp_packed_params* p = &primitive.params;
+static void packed_params(const gltf_packed_skin* packed, sp_packed_params* p) {
+    memset(p, 0, sizeof(*p));
     p->method = packed->method;
     p->influences = packed->influences;
     p->joint_count = packed->joint_count;
@@ -156,6 +149,39 @@ static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, 
         p->axis_samples[i] = packed->axis_samples[i];
     p->has_max_error = isfinite(packed->max_error);
     p->max_error = p->has_max_error ? packed->max_error : 0;
+}
+
+int cli_check_shared_vertices(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
+                              char* err, size_t err_size) {
+    sp_packed_params ours, theirs;
+    packed_params(packed, &ours);
+    for (size_t m = 0; m <= mesh; ++m) {
+        size_t end = m == mesh ? primitive : gltf_primitive_count(doc, m);
+        for (size_t p = 0; p < end; ++p) {
+            gltf_packed_skin other;
+            char ignored[CLI_ERR_SIZE]; /* a malformed earlier extension was reported there */
+            if (gltf_get_packed(doc, m, p, &other, ignored, sizeof(ignored)) <= 0 || other.vertices != packed->vertices)
+                continue;
+            packed_params(&other, &theirs);
+            if (sp_packed_params_equal(&ours, &theirs) && other.tuple_table == packed->tuple_table) continue;
+            snprintf(err, err_size, "shares \"vertices\" accessor %d with mesh %zu primitive %zu but declares %s",
+                     packed->vertices, m, p,
+                     other.tuple_table != packed->tuple_table ? "another \"tupleTable\"" : "different properties");
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,
+                         uint32_t words_per_vertex, size_t primitive_vertex_count, const uint16_t* lut, size_t lut_size,
+                         size_t skin_joint_count, const sp_packed_meshlets* meshlets, cli_decoded_skin* out,
+                         char* err, size_t err_size) {
+    memset(out, 0, sizeof(*out));
+    /* Every format rule is the library's (sp_validate_packed); this only passes what the file says. */
+    sp_packed_primitive primitive;
+    memset(&primitive, 0, sizeof(primitive));
+    packed_params(packed, &primitive.params);
     primitive.words = words;
     primitive.vertex_count = vertex_count;
     primitive.words_per_vertex = words_per_vertex;

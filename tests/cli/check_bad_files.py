@@ -150,7 +150,24 @@ def lut_size(d):
     return d["accessors"][ext_of(d)["tupleTable"]]["count"]
 
 
+def twin_primitive(change):
+    """A second primitive sharing the packed words, its extension edited by change(ext, document)."""
+    def edit(d, b):
+        prim = skinned(d)
+        twin = copy.deepcopy(prim)
+        change(twin["extensions"][EXT], d)
+        next(m for m in d["meshes"] if prim in m["primitives"])["primitives"].append(twin)
+    return edit
+
+
+def another_table(ext, d):
+    d["accessors"].append(copy.deepcopy(d["accessors"][ext["tupleTable"]]))
+    ext["tupleTable"] = len(d["accessors"]) - 1
+
+
 PACKED = [
+    ("twin-other-n", "declares different properties", twin_primitive(lambda e, d: e.__setitem__("n", e["n"] - 1))),
+    ("twin-other-table", 'another "tupleTable"', twin_primitive(another_table)),
     ("code-past-count", "code", word_fields(code_value=lambda e: oss_code_count(e["n"]))),
     ("tuple-past-table", "tuple", word_fields(tuple_value=lambda e: (1 << e["tupleBits"]) - 1)),
     ("lut-joint-past-count", "joint", lut_joint),

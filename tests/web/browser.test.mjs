@@ -227,6 +227,13 @@ const BROKEN = {
     copy.extensions[SKINPACK_EXTENSION].jointCount -= 1;
     json.meshes.push({ name: 'fox1', primitives: [copy] });
   }, /shares "vertices" accessor \d+ with mesh 0 "fox1" primitive 0 but declares different properties/, 'mesh 1 "fox1" primitive 0'],
+  sharedWordsOtherTable: [(json) => {
+    const primitive = json.meshes[0].primitives[0];
+    const copy = JSON.parse(JSON.stringify(primitive));
+    json.accessors.push({ ...json.accessors[extOf(json).tupleTable] });
+    copy.extensions[SKINPACK_EXTENSION].tupleTable = json.accessors.length - 1;
+    json.meshes.push({ name: 'fox1', primitives: [copy] });
+  }, /shares "vertices" accessor \d+ with mesh 0 "fox1" primitive 0 but declares another "tupleTable"/, 'mesh 1 "fox1" primitive 0'],
   wordsRange: [(json) => { json.accessors[extOf(json).vertices].byteOffset = 8; }, /"vertices" accessor \d+ ends at byte \d+, past its bufferView/],
   sparse: [(json) => { json.accessors[extOf(json).tupleTable].normalized = true; }, /"tupleTable" accessor \d+ must be neither sparse nor normalized/],
   tableEntry: [(json, bin) => {

@@ -67,7 +67,9 @@ export class SkinpackGLTFPlugin {
         const first = seen.get(ext.vertices);
         if (first && !paramsEqual(first.params, params))
           return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares different properties`));
-        if (!first) seen.set(ext.vertices, { params, where });
+        if (first && first.tupleTable !== ext.tupleTable)
+          return Promise.reject(new Error(`SkinpackGLTFPlugin: ${where}: shares "vertices" accessor ${ext.vertices} with ${first.where} but declares another "tupleTable"`));
+        if (!first) seen.set(ext.vertices, { params, where, tupleTable: ext.tupleTable });
       }
     }
     return null;
