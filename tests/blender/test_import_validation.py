@@ -200,6 +200,17 @@ def corrupt_files(out):
     case("compact_any", "contradicting_share", contradicting_share,
          "primitive 1: shares its vertices accessor with mesh", "declares other properties")
 
+    # ... or the same parameters with another tuple table.
+    def other_table_share(glb):
+        mesh = glb.json["meshes"][0]
+        second = json.loads(json.dumps(mesh["primitives"][0]))
+        accessors = glb.json["accessors"]
+        accessors.append(dict(accessors[second["extensions"][EXTENSION]["tupleTable"]]))
+        second["extensions"][EXTENSION]["tupleTable"] = len(accessors) - 1
+        mesh["primitives"].append(second)
+    case("compact_any", "other_table_share", other_table_share,
+         "primitive 1: shares its vertices accessor with mesh", "declares another tupleTable")
+
     # A meshlet vertex entry that points past the primitive's vertices.
     def meshlet_vertex(glb):
         glb.set_row(glb.extension()["meshlets"]["vertices"], 0, [1000])

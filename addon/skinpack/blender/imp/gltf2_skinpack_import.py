@@ -160,9 +160,11 @@ def decode_file(gltf):
                 if native.load() is None:
                     raise _Refusal(native.load_error())
                 params, joints, weights = validate_primitive(gltf, mesh_index, primitive, extension)
-                shared = first_params.setdefault(extension["vertices"], (params, where))
+                shared = first_params.setdefault(extension["vertices"], (params, where, extension.get("tupleTable")))
                 if shared[1] != where and not native.params_equal(shared[0], params):
                     raise _Refusal("shares its vertices accessor with %s but declares other properties" % shared[1])
+                if shared[1] != where and shared[2] != extension.get("tupleTable"):
+                    raise _Refusal("shares its vertices accessor with %s but declares another tupleTable" % shared[1])
             except _Refusal as error:
                 raise ImportRefused("Skinpack: %s: %s: %s" % (getattr(gltf, "filename", "?"), where, error)) from None
             decoded.append((primitive, joints, weights))
