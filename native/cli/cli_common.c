@@ -151,26 +151,17 @@ static void packed_params(const gltf_packed_skin* packed, sp_packed_params* p) {
     p->max_error = p->has_max_error ? packed->max_error : 0;
 }
 
-int cli_check_shared_vertices(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
-                              char* err, size_t err_size) {
+int cli_check_shared_vertices(const gltf_packed_skin* packed, const gltf_packed_skin* earlier, size_t mesh,
+                              size_t primitive, char* err, size_t err_size) {
+    if (earlier->vertices != packed->vertices) return 0;
     sp_packed_params ours, theirs;
     packed_params(packed, &ours);
-    for (size_t m = 0; m <= mesh; ++m) {
-        size_t end = m == mesh ? primitive : gltf_primitive_count(doc, m);
-        for (size_t p = 0; p < end; ++p) {
-            gltf_packed_skin other;
-            char ignored[CLI_ERR_SIZE]; /* a malformed earlier extension was reported there */
-            if (gltf_get_packed(doc, m, p, &other, ignored, sizeof(ignored)) <= 0 || other.vertices != packed->vertices)
-                continue;
-            packed_params(&other, &theirs);
-            if (sp_packed_params_equal(&ours, &theirs) && other.tuple_table == packed->tuple_table) continue;
-            snprintf(err, err_size, "shares \"vertices\" accessor %d with mesh %zu primitive %zu but declares %s",
-                     packed->vertices, m, p,
-                     other.tuple_table != packed->tuple_table ? "another \"tupleTable\"" : "different properties");
-            return -1;
-        }
-    }
-    return 0;
+    packed_params(earlier, &theirs);
+    if (sp_packed_params_equal(&ours, &theirs) && earlier->tuple_table == packed->tuple_table) return 0;
+    snprintf(err, err_size, "shares \"vertices\" accessor %d with mesh %zu primitive %zu but declares %s",
+             packed->vertices, mesh, primitive,
+             earlier->tuple_table != packed->tuple_table ? "another \"tupleTable\"" : "different properties");
+    return -1;
 }
 
 static int decode_arrays(const gltf_packed_skin* packed, const uint32_t* words, size_t vertex_count,

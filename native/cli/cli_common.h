@@ -54,9 +54,10 @@ int cli_decode_packed(const gltf_doc* doc, size_t mesh, size_t primitive, const 
 
 /* Primitives that reference the same "vertices" accessor must declare identical properties
  * (spec 1.0, Accessors; the library's sp_packed_params_equal, and the same "tupleTable"):
- * checks the primitive against every earlier one. 0, or -1 with err naming the other primitive. */
-int cli_check_shared_vertices(const gltf_doc* doc, size_t mesh, size_t primitive, const gltf_packed_skin* packed,
-                              char* err, size_t err_size);
+ * checks packed against an earlier primitive's extension (at mesh, primitive). 0, or -1 with err
+ * naming the earlier primitive. */
+int cli_check_shared_vertices(const gltf_packed_skin* packed, const gltf_packed_skin* earlier, size_t mesh,
+                              size_t primitive, char* err, size_t err_size);
 
 void cli_decoded_skin_free(cli_decoded_skin* skin);
 

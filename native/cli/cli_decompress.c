@@ -102,10 +102,12 @@ static long decode_all(gltf_doc* doc, const char* input, decoded_primitive** out
                 goto fail;
             }
             if (has == 0) continue;
-            if (cli_check_shared_vertices(doc, m, p, &packed, err, sizeof(err))) {
-                fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
-                goto fail;
-            }
+            for (size_t i = 0; i < count; ++i)
+                if (cli_check_shared_vertices(&packed, &list[i].packed, list[i].mesh, list[i].primitive, err,
+                                              sizeof(err))) {
+                    fprintf(stderr, "Error: %s: mesh %zu primitive %zu: %s\n", input, m, p, err);
+                    goto fail;
+                }
             decoded_primitive* grown = cli_grow(list, &capacity, count, sizeof(*list));
             if (!grown) goto fail;
             list = grown;

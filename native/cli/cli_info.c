@@ -285,8 +285,11 @@ int skinpack_cmd_info(int argc, char** argv) {
             int has = gltf_get_packed(doc, m, p, &info.ext, err, sizeof(err));
             int ok = 0;
             if (has > 0) {
-                ok = cli_check_shared_vertices(doc, m, p, &info.ext, err, sizeof(err)) == 0 &&
-                     info_packed(doc, m, p, &info, err, sizeof(err)) == 0;
+                ok = 1;
+                for (size_t i = 0; i < count && ok; ++i)
+                    ok = !infos[i].packed || cli_check_shared_vertices(&info.ext, &infos[i].ext, infos[i].mesh,
+                                                                       infos[i].primitive, err, sizeof(err)) == 0;
+                ok = ok && info_packed(doc, m, p, &info, err, sizeof(err)) == 0;
             } else if (has == 0) {
                 gltf_skin_attributes at;
                 int skinned = gltf_primitive_skin(doc, m, p, &at, err, sizeof(err));
