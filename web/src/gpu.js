@@ -57,7 +57,8 @@ function floatLiteral(value) {
 function gridUnpackMacro(codec) {
   const first = codec.method === 'fixed' ? 0 : 1;
   let shift = 0;
-  const statements = codec.componentBits.map((bits, c) => {
+  // componentBits has one entry a stored slot (first..K-1), zeros after (sp_codec.component_bits)
+  const statements = codec.componentBits.slice(0, codec.influences - first).map((bits, c) => {
     const mask = bits >= 32 ? 0xffffffff : 2 ** bits - 1;
     const statement = `q[${first + c}] = (code >> ${shift}u) & ${uintLiteral(mask)};`;
     shift += bits;

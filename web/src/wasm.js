@@ -151,11 +151,6 @@ function setParams(call, p) {
                      p.maxError === undefined ? 0 : 1, p.maxError ?? 0);
 }
 
-function storedWeights(method, influences) {
-  if (!['fixed', 'cube', 'pot'].includes(method)) return 0;
-  return method === 'fixed' ? influences : influences - 1;
-}
-
 // The codec the library reported, in the shape the GPU path's uniforms and the viewer read.
 function reportedCodec(call, arena, params) {
   const out = arena.alloc(8 * CODEC_VALUES);
@@ -168,8 +163,7 @@ function reportedCodec(call, arena, params) {
     method: METHODS[methodIndex], methodId: methodIndex, influences, jointCount: Number(params.jointCount),
     weightBits: Number(v[2]), tupleBits: Number(params.tupleBits),
     wordsPerVertex: wordsPerVertex(Number(params.tupleBits), Number(v[2])),
-    // The library's component_bits holds one entry a stored weight (Fixed stores q1 too), zeros after.
-    componentBits: Array.from(v.subarray(3, 3 + storedWeights(METHODS[methodIndex], influences)), Number), n: Number(v[7]), nBig: v[7],
+    componentBits: Array.from(v.subarray(3, 7), Number), n: Number(v[7]), nBig: v[7],
     axisSamples, axisNumbers: axisSamples.map(Number),
     // Any's weight divisors i (q_i - 1) in binary64, as the C decoder computes them: the GPU path's uniforms.
     axisDivisors: axisSamples.map((q, a) => (a + 2) * Number(q - 1n)), scale: v[11], maxCode: v[12], maxCodeNumber: Number(v[12]),
