@@ -234,7 +234,8 @@ export function decodeGlsl(codec, rowWidth = TUPLE_TEXTURE_WIDTH) {
 
 /** skinpackDivisors of a codec: s (grid methods) or i (q_i - 1) (any, binary64 like the CPU decoder, then binary32). */
 export function codecDivisors(codec) {
-  if (codec.method === 'any') return [1, ...codec.axisDivisors, 0, 0].slice(0, 4);
+  // Any's divisors i (q_i - 1), i = 2..K, in binary64 as the C decoder computes them (exact: q_i < 2^32)
+  if (codec.method === 'any') return [1, ...codec.axisNumbers.map((q, a) => (a + 2) * (q - 1)), 0, 0].slice(0, 4);
   return [Number(codec.scale), 0, 0, 0];
 }
 

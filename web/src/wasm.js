@@ -164,9 +164,7 @@ function reportedCodec(call, arena, params) {
     weightBits: Number(v[2]), tupleBits: Number(params.tupleBits),
     wordsPerVertex: wordsPerVertex(Number(params.tupleBits), Number(v[2])),
     componentBits: Array.from(v.subarray(3, 7), Number), n: Number(v[7]), nBig: v[7],
-    axisSamples, axisNumbers: axisSamples.map(Number),
-    // Any's weight divisors i (q_i - 1) in binary64, as the C decoder computes them: the GPU path's uniforms.
-    axisDivisors: axisSamples.map((q, a) => (a + 2) * Number(q - 1n)), scale: v[11], maxCode: v[12], maxCodeNumber: Number(v[12]),
+    axisSamples, axisNumbers: axisSamples.map(Number), scale: v[11], maxCode: v[12], maxCodeNumber: Number(v[12]),
     maxError: lib.spw_codec_max_error(call), params,
   };
 }
