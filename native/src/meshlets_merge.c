@@ -60,6 +60,14 @@ void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan)
     sp_meshlet_reset_open(ctx);
 }
 
+void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a)
+{
+    plan->next[plan->tail[b]] = a;
+    plan->tail[b] = plan->tail[a];
+    plan->triangle_count[b] = (uint16_t)(plan->triangle_count[b] + plan->triangle_count[a]);
+    plan->merged[a] = 1;
+}
+
 /* Adds every triangle of the group that starts at meshlet m to the open meshlet; with
  * check, stops at the first that does not fit and returns 0. */
 static int add_group(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m, int check)
@@ -97,8 +105,8 @@ static size_t list_underfull(const sp_meshlet_context* ctx, sp_meshlet_plan* pla
 {
     size_t count = 0;
     for (uint32_t m = 0; m < plan->count; ++m)
-        if (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
-            plan->triangle_count[m] < ctx->options.max_triangles / 2)
+        if (!plan->merged[m] && (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
+                                 plan->triangle_count[m] < ctx->options.max_triangles / 2))
             plan->keys[count++] = (uint64_t)rank[plan->order[plan->start[m]]] << 32 | m;
     qsort(plan->keys, count, sizeof(uint64_t), compare_keys);
     for (size_t i = 0; i < count; ++i)
@@ -121,10 +129,7 @@ static void merge_into_neighbour(sp_meshlet_context* ctx, sp_meshlet_plan* plan,
             uint32_t b = plan->spatial[side == 0 ? at - d : at + d];
             if (plan->merged[b] || !groups_fit(ctx, plan, b, a))
                 continue;
-            plan->next[plan->tail[b]] = a; /* b's group absorbs a's */
-            plan->tail[b] = plan->tail[a];
-            plan->triangle_count[b] = (uint16_t)(plan->triangle_count[b] + plan->triangle_count[a]);
-            plan->merged[a] = 1;
+            sp_meshlet_plan_append(plan, b, a);
             return;
         }
 }

@@ -71,7 +71,10 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
                           sp_meshlet_align8(triangle_count * sizeof(uint32_t));      /* rank */
     size_t tuples = sp_meshlet_align8((tuple_slots + 1) * sizeof(uint32_t)) + /* tuple_stamp */
                     sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
-    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count);
+    size_t parts = sp_meshlet_parts_scratch_bound(triangle_count, vertex_count);
+    size_t pack = sp_meshlet_pack_scratch_bound(triangle_count); /* after the parts step, in the same bytes */
+    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count) +
+           (parts > pack ? parts : pack);
 }
 
 /* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
@@ -454,8 +457,9 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     build_spatial_order(ctx, &s);
+    size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
 
-    for (size_t done = 0; done < t_count; ++done) {
+    for (size_t done = packed; done < t_count; ++done) {
         if (ctx->open_triangle_count == 0) {
             emit(ctx, &s, next_seed(ctx, &s));
             continue;
@@ -489,9 +493,12 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
     }
     sp_meshlet_plan_close(ctx, &s.plan);
+    sp_meshlet_plan_pack(ctx, &s.plan, cursor);
     sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
     sp_meshlet_plan_link(&s.plan);
     sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
-    sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live); /* live: all 0, every triangle is out */
+    /* live as the exchange step's zeroed vertex scratch (the parts closed whole never left it) */
+    memset(s.live, 0, v_count * sizeof(uint32_t));
+    sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live);
     sp_meshlet_plan_write(ctx, &s.plan);
 }
