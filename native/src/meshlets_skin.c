@@ -35,6 +35,8 @@
 #define PROXIMITY_WINDOW_MAX 2048 /* widened 8x at a time up to this */
 #define JUMP_JOINT_PENALTY 4.0f   /* distance factor per new joint (x joint_cost) for such jumps */
 #define JOINT_DISTANCE_FACTOR 1.0f /* tie-break: distance factor per joint a candidate adds to the palette */
+#define LATE_VERTICES_DIVISOR 7   /* the last max_vertices / 7 vertices of a meshlet are its "late" ones, */
+#define LATE_JOINT_COST 3.0f      /* where a new palette joint costs as much as 3 new vertices */
 #define SEEDS_PER_MESHLET 4       /* seed candidates a finished meshlet leaves on its border */
 #define SEED_POOL 256             /* seed candidates kept at most */
 
@@ -360,6 +362,10 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
         return best;
     float point[3];
     open_centroid(ctx, s, point);
+    /* in the meshlet's last vertices a new joint also costs LATE_JOINT_COST (see the top) */
+    float joint_cost = ctx->options.joint_cost;
+    if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
+        joint_cost += LATE_JOINT_COST;
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
         uint32_t v = ctx->open_vertices[i];
         const uint32_t* list = s->adjacency + s->adjacency_offset[v];
@@ -375,7 +381,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
-            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            float cost = priority + joint_cost * (float)new_joints;
             if (ctx->options.tuple_cost > 0.0f)
                 cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
