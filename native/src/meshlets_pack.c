@@ -57,7 +57,7 @@ typedef struct packer {
 size_t sp_meshlet_pack_scratch_bound(size_t triangle_count)
 {
     size_t m = triangle_count; /* plan meshlets, hence pieces and bins, at most */
-    return sp_meshlet_align8(m * sizeof(uint64_t)) + sp_meshlet_align8(m * sizeof(piece)) +
+    return sp_meshlet_align8(m * sizeof(piece)) +
            sp_meshlet_align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) +
            sp_meshlet_align8(m * sizeof(pack_bin)) + sp_meshlet_align8(JOINT_MARKS * sizeof(uint32_t));
 }
@@ -269,7 +269,7 @@ void sp_meshlet_plan_pack(sp_meshlet_context* ctx, sp_meshlet_plan* plan, unsign
 {
     packer p;
     p.ctx = ctx;
-    uint64_t* keys = sp_meshlet_carve(&scratch, plan->count * sizeof(uint64_t));
+    uint64_t* keys = plan->keys; /* the merge step's sort keys, free until then */
     p.pieces = sp_meshlet_carve(&scratch, plan->count * sizeof(piece));
     p.pool = sp_meshlet_carve(&scratch, ctx->triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
     p.bins = sp_meshlet_carve(&scratch, plan->count * sizeof(pack_bin));

@@ -3,26 +3,28 @@
  * meshoptimizer (the count drives the cost of mesh-shader skinning), then few palette entries,
  * then few local tuple bits; the palette limit max_joints is a hard cap, never exceeded.
  *
- * Grows one meshlet at a time like meshopt_buildMeshlets (1.x): the next triangle is the best
- * live triangle adjacent to the meshlet's vertices that fits every limit. A candidate costs its
- * topological priority (topology_priority) plus joint_cost per joint it would add to the
- * palette and tuple_cost per tuple its new vertices would add to the local LUT; both default to
- * 0, because on the benchmark meshes even a joint tie-break (any joint_cost below one priority
- * step) costs a few meshlets against the distance tie-break; the palette cap is enforced either
- * way, and the refine step lowers the palette sum afterwards. Ties go to the
- * candidate nearest the centre of the meshlet's triangles, its distance scaled by
- * 1 + JOINT_DISTANCE_FACTOR per joint it would add: unlike a joint term in the cost, this keeps
- * the meshlets compact (no more meshlets on the benchmark meshes) and still steers growth along
- * the palette it has (0.1-1.2 % fewer palette entries than plain distance on the subdivided
- * benchmark meshes). When no adjacent triangle fits, the
- * meshlet closes, leaves seed candidates on its border, and the next meshlet starts at the
- * least enclosed seed (fewest free triangles around its corners, then nearest the mesh's low
- * corner), so meshlets sweep across the surface and leave no slivers behind. When the surface
- * patch runs out, the nearest free triangle (searched in a widening window of the Morton order
- * of triangle centroids, where meshoptimizer uses a k-d tree) continues it. Meshlets are
- * recorded as a plan and written at the end, after underfull ones are merged
- * (meshlets_merge.c) and border triangles moved where they cost fewer palette entries
- * (meshlets_refine.c) or traded between neighbours (meshlets_exchange.c).
+ * First, every connected part of the mesh that fits one meshlet whole is closed as one meshlet
+ * and left out of growth (meshlets_parts.c). The rest grows one meshlet at a time like
+ * meshopt_buildMeshlets (1.x): the next triangle is the best live triangle adjacent to the
+ * meshlet's vertices that fits every limit. A candidate costs its topological priority
+ * (topology_priority) plus joint_cost per joint it would add to the palette and tuple_cost per
+ * tuple its new vertices would add to the local LUT; both options default to 0, because on the
+ * benchmark meshes a joint term over the whole growth costs meshlets against the distance
+ * tie-break. Only in a meshlet's last max_vertices / LATE_VERTICES_DIVISOR vertices, where the
+ * vertex limit is about to close it anyway, does a new joint cost LATE_JOINT_COST on top: the
+ * meshlet then closes along the palette it has (0-4 % fewer palette entries on the benchmark
+ * meshes, no more meshlets). Ties go to the candidate nearest the centre of the meshlet's
+ * triangles, its distance scaled by 1 + JOINT_DISTANCE_FACTOR per joint it would add, which
+ * keeps the meshlets compact and still steers growth along the palette. When no adjacent
+ * triangle fits, the meshlet closes, leaves seed candidates on its border, and the next meshlet
+ * starts at the least enclosed seed (fewest free triangles around its corners, then nearest the
+ * mesh's low corner), so meshlets sweep across the surface and leave no slivers behind. When
+ * the surface patch runs out, the nearest free triangle (searched in a widening window of the
+ * Morton order of triangle centroids, where meshoptimizer uses a k-d tree) continues it.
+ * Meshlets are recorded as a plan and written at the end, after underfull ones are packed by
+ * their joints (meshlets_pack.c) and merged with near ones (meshlets_merge.c) and border
+ * triangles are moved where they cost fewer palette entries (meshlets_refine.c) or traded
+ * between neighbours (meshlets_exchange.c).
  */
 #include "meshlets_internal.h"
 
