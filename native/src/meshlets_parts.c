@@ -11,6 +11,11 @@
  */
 #include "meshlets_internal.h"
 
+/* Parts under max_vertices / 8 vertices are left to growth: those are the faces of a
+ * flat-shaded mesh (every face its own part), which growth's proximity jumps keep together
+ * better than packing does. */
+#define PART_MIN_VERTICES_DIVISOR 8
+
 size_t sp_meshlet_parts_scratch_bound(size_t triangle_count, size_t vertex_count)
 {
     return 3 * sp_meshlet_align8(vertex_count * sizeof(uint32_t)) + /* parent, part start, part fill */
@@ -51,7 +56,8 @@ static void find_parts(const sp_meshlet_context* ctx, const uint32_t* adjacency_
     size_t offset = 0;
     for (size_t r = 0; r < v_count; ++r) {
         uint32_t triangles = part_start[r];
-        int fits = triangles > 0 && triangles <= ctx->options.max_triangles && part_fill[r] <= ctx->options.max_vertices;
+        int fits = triangles > 0 && triangles <= ctx->options.max_triangles && part_fill[r] <= ctx->options.max_vertices &&
+                   part_fill[r] >= ctx->options.max_vertices / PART_MIN_VERTICES_DIVISOR;
         part_start[r] = fits ? (uint32_t)offset : UINT32_MAX;
         offset += fits ? triangles : 0;
         part_fill[r] = 0;
