@@ -99,7 +99,11 @@ static void collect_pieces(packer* p, sp_meshlet_context* ctx, const sp_meshlet_
  * (skip, add: NO_PIECE for none). */
 static uint32_t joints_with(packer* p, uint32_t b, uint32_t skip, uint32_t add)
 {
-    uint32_t count = 0, stamp = ++p->stamp;
+    if (++p->stamp == 0) { /* wrapped: clear the marks so that no old stamp matches */
+        memset(p->mark, 0, JOINT_MARKS * sizeof(uint32_t));
+        p->stamp = 1;
+    }
+    uint32_t count = 0, stamp = p->stamp;
     for (uint32_t i = p->bins[b].first; i != NO_PIECE; i = p->pieces[i].next) {
         if (i == skip)
             continue;
