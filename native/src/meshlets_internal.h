@@ -130,8 +130,8 @@ void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t 
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
 /* Group b absorbs group a (a is marked merged; the caller checked every limit). */
 void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a);
-/* meshlets_parts.c: closes every connected part that fits one meshlet whole (palette cap
- * included) as a meshlet of the plan and sets taken[t] = 1 for its triangles; returns how many
+/* meshlets_parts.c: closes every connected part of at least max_vertices / 8 vertices that fits
+ * one meshlet whole (palette cap included) as a meshlet of the plan and sets taken[t] = 1 for its triangles; returns how many
  * triangles it took (adjacency_offset: vertex_count + 1 entries, as the skin builder keeps it). */
 size_t sp_meshlet_parts_scratch_bound(size_t triangle_count, size_t vertex_count);
 size_t sp_meshlet_plan_close_parts(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* adjacency_offset,

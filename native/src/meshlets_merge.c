@@ -3,11 +3,11 @@
  *
  * Greedy growth leaves a few underfull meshlets behind (slivers between finished meshlets, the
  * ends of thin parts). The builder first records its meshlets as a plan (triangle lists, nothing
- * written); then each underfull meshlet, smallest first, is merged with the nearest underfull
- * meshlet (in the Morton order of their first triangles, a window on each side) that fits
- * together with it within every limit, the palette cap included. Every merge saves one meshlet
- * and never adds a palette entry (the union of two palettes is at most their sum). The plan is
- * then refined and written out by meshlets_refine.c.
+ * written); after the packing by joints (meshlets_pack.c), each underfull group, smallest first,
+ * is merged with the nearest underfull meshlet (in the Morton order of their first triangles, a
+ * window on each side) that fits together with it within every limit, the palette cap
+ * included. Every merge saves one meshlet and never adds a palette entry (the union of two
+ * palettes is at most their sum). The plan is then refined and written out by meshlets_refine.c.
  */
 #include "meshlets_internal.h"
 
