@@ -44,6 +44,22 @@ SP_INLINE SIMD_FN mask m_and(mask a, mask b) { return _mm256_and_pd(a, b); }
 SP_INLINE SIMD_FN unsigned m_bits(mask a) { return (unsigned)_mm256_movemask_pd(a); }
 SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm256_add_pd(x, _mm256_and_pd(m, y)); }
 
+/* Counters as the doubles 2^52 + c, stepped by integer arithmetic on their bits with the all-ones
+ * mask lanes (-1): one instruction a step, where v_add_where takes two. */
+#define COUNTER_BIAS 4503599627370496.0 /* 2^52 */
+typedef __m256d counter;
+SP_INLINE SIMD_FN counter c_splat(uint32_t c) { return v_splat(COUNTER_BIAS + c); }
+SP_INLINE SIMD_FN counter c_inc_where(counter c, mask m)
+{
+    return _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(c), _mm256_castpd_si256(m)));
+}
+SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m)
+{
+    return _mm256_castsi256_pd(_mm256_add_epi64(_mm256_castpd_si256(c), _mm256_castpd_si256(m)));
+}
+SP_INLINE SIMD_FN vec c_threshold(vec d) { return v_add(d, v_splat(COUNTER_BIAS)); }
+SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
+
 SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 {
     simd_layout layout = {(int)k};
@@ -117,12 +133,17 @@ SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
     memcpy(out, &packed, sizeof(packed));
 }
 
-/* Every code of the block <= max_code: unsigned compare as signed with the sign bits flipped. */
-SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, uint64_t max_code)
+/* Every code of `blocks` blocks <= max_code: unsigned compares as signed with the sign bits
+ * flipped, their results or-ed and tested once. */
+SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, size_t blocks, uint64_t max_code)
 {
     __m256i flip = _mm256_set1_epi64x(INT64_MIN), top = _mm256_set1_epi64x((int64_t)(max_code ^ (uint64_t)INT64_MIN));
-    __m256i raw = _mm256_loadu_si256((const __m256i*)codes);
-    return _mm256_testz_si256(_mm256_cmpgt_epi64(_mm256_xor_si256(raw, flip), top), _mm256_set1_epi64x(-1));
+    __m256i over = _mm256_setzero_si256();
+    for (size_t b = 0; b < blocks; ++b) {
+        __m256i raw = _mm256_loadu_si256((const __m256i*)(codes + b * BLOCK));
+        over = _mm256_or_si256(over, _mm256_cmpgt_epi64(_mm256_xor_si256(raw, flip), top));
+    }
+    return _mm256_testz_si256(over, over);
 }
 
 /*

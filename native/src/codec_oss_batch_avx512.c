@@ -45,6 +45,14 @@ SP_INLINE SIMD_FN mask m_and(mask a, mask b) { return (mask)(a & b); }
 SP_INLINE SIMD_FN unsigned m_bits(mask a) { return a; }
 SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm512_mask_add_pd(x, m, x, y); }
 
+/* Counters as plain doubles: a masked add is one instruction already. */
+typedef __m512d counter;
+SP_INLINE SIMD_FN counter c_splat(uint32_t c) { return v_splat(c); }
+SP_INLINE SIMD_FN counter c_inc_where(counter c, mask m) { return v_add_where(c, m, v_splat(1.0)); }
+SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m) { return v_add_where(c, m, v_splat(-1.0)); }
+SP_INLINE SIMD_FN vec c_threshold(vec d) { return d; }
+SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
+
 /* Indices between 8 vertices of k floats (AoS, as two 16-float registers: floats 0..15 and
  * floats 8k-16..8k-1, overlapping for k < 4) and component pairs (c, c + 1) of the 8 vertices
  * (SoA, one register per pair: component c in the low half). */
@@ -118,9 +126,11 @@ SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
     _mm_storel_epi64((__m128i*)out, _mm512_cvtepi64_epi8(_mm512_cvttpd_epi64(count)));
 }
 
-SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, uint64_t max_code)
+SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, size_t blocks, uint64_t max_code)
 {
-    return !_mm512_cmpgt_epu64_mask(_mm512_loadu_si512(codes), _mm512_set1_epi64((int64_t)max_code));
+    __m512i top = _mm512_set1_epi64((int64_t)max_code), high = _mm512_setzero_si512();
+    for (size_t b = 0; b < blocks; ++b) high = _mm512_max_epu64(high, _mm512_loadu_si512(codes + b * BLOCK));
+    return !_mm512_cmpgt_epu64_mask(high, top);
 }
 
 /*

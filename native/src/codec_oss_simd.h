@@ -19,8 +19,11 @@
  *   v_splat v_zero v_add v_sub v_mul v_div v_sqrt v_max v_min v_floor v_trunc
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
  *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
+ *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
+ *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
+ *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
  *   load_weights, store_weights (AoS floats <-> K vectors), load_codes, store_codes (u64),
- *   store_counts (lane values as bytes), codes_valid (every code <= max_code)
+ *   store_counts (lane values as bytes), codes_valid (every code of some blocks <= max_code)
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
@@ -87,20 +90,21 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
  */
 SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remainder, vec* q)
 {
-    vec rank[SP_MAX_INFLUENCES], one = v_splat(1.0);
+    counter rank[SP_MAX_INFLUENCES]; /* from 0 to k - 1, so the counters never leave their range */
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) rank[i] = v_splat((double)(k - 1 - i)); /* every later slot beats i ... */
+    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(k - 1 - i); /* every later slot beats i ... */
     SP_UNROLL
     for (uint32_t a = 0; a < k; ++a) { /* ... unless i wins against it; an earlier slot a beats b when it wins */
         SP_UNROLL
         for (uint32_t b = a + 1; b < k; ++b) {
             mask a_wins = m_ge(remainder[a], remainder[b]);
-            rank[a] = v_add_where(rank[a], a_wins, v_splat(-1.0));
-            rank[b] = v_add_where(rank[b], a_wins, one);
+            rank[a] = c_dec_where(rank[a], a_wins);
+            rank[b] = c_inc_where(rank[b], a_wins);
         }
     }
+    vec threshold = c_threshold(deficit), one = v_splat(1.0);
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) q[i] = v_add_where(q[i], m_gt(deficit, rank[i]), one);
+    for (uint32_t i = 0; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one);
     return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
 }
 
@@ -169,7 +173,9 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights,
         for (size_t b = 0; b < blocks; ++b)
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
-    for (size_t b = 0; b < blocks; ++b)
+    unsigned any = 0;
+    for (size_t b = 0; b < blocks; ++b) any |= missed[b];
+    for (size_t b = 0; any && b < blocks; ++b) /* any: most chunks have no lane to redo */
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
 }
@@ -317,7 +323,9 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
         }
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
-    for (size_t b = 0; b < blocks; ++b)
+    unsigned any = 0;
+    for (size_t b = 0; b < blocks; ++b) any |= missed[b];
+    for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
 }
@@ -330,7 +338,9 @@ SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const uint64_t* co
     while (v + BLOCK <= count) {
         size_t blocks = (count - v) / BLOCK, valid = 0;
         if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
-        while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
+        if (codes_valid(codes + v, blocks, codec->max_code)) valid = blocks; /* the common case: one test a chunk */
+        else
+            while (valid < blocks && codes_valid(codes + v + valid * BLOCK, 1, codec->max_code)) ++valid;
         if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
         decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
         v += valid * BLOCK;
