@@ -60,6 +60,44 @@ SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m)
 SP_INLINE SIMD_FN vec c_threshold(vec d) { return v_add(d, v_splat(COUNTER_BIAS)); }
 SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
 
+/* Eight float or int32 lanes for decode in 32-bit lanes. */
+#define NBLOCK 8
+#define NARROW_CHUNK 8 /* DECODE_CHUNK's vertices */
+typedef __m256 nvec;
+typedef __m256i nint;
+typedef __m256i nmask;
+SP_INLINE SIMD_FN nvec f_splat(float x) { return _mm256_set1_ps(x); }
+SP_INLINE SIMD_FN nvec f_add(nvec a, nvec b) { return _mm256_add_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sub(nvec a, nvec b) { return _mm256_sub_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_mul(nvec a, nvec b) { return _mm256_mul_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sqrt(nvec a) { return _mm256_sqrt_ps(a); }
+SP_INLINE SIMD_FN nvec f_fmadd(nvec a, nvec b, nvec c) { return _mm256_fmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nvec f_fnmadd(nvec a, nvec b, nvec c) { return _mm256_fnmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nint i_splat(int32_t x) { return _mm256_set1_epi32(x); }
+SP_INLINE SIMD_FN nint i_add(nint a, nint b) { return _mm256_add_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_sub(nint a, nint b) { return _mm256_sub_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_mullo(nint a, nint b) { return _mm256_mullo_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_max(nint a, nint b) { return _mm256_max_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_min(nint a, nint b) { return _mm256_min_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_shr2(nint a) { return _mm256_srai_epi32(a, 2); }
+SP_INLINE SIMD_FN nmask i_gt(nint a, nint b) { return _mm256_cmpgt_epi32(a, b); }
+SP_INLINE SIMD_FN nmask n_or(nmask a, nmask b) { return _mm256_or_si256(a, b); }
+SP_INLINE SIMD_FN unsigned n_bits(nmask a) { return (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(a)); }
+SP_INLINE SIMD_FN nvec i_to_f(nint a) { return _mm256_cvtepi32_ps(a); }
+SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm256_cvttps_epi32(a); } /* NaN and overflow: INT32_MIN */
+SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm256_castps_si256(a); }
+SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm256_castsi256_ps(a); }
+
+/* floor(a / 9) = floor(a m / 2^33) with m = (2^33 + 1) / 9 for 0 <= a < 2^33 (the error
+ * a / (9 2^33) stays below 1/9), on the even and the odd lanes' 64-bit products. */
+SP_INLINE SIMD_FN nint i_div9(nint a)
+{
+    __m256i m = _mm256_set1_epi32(954437177);
+    __m256i even = _mm256_srli_epi64(_mm256_mul_epu32(a, m), 33);
+    __m256i odd = _mm256_srli_epi64(_mm256_mul_epu32(_mm256_srli_epi64(a, 32), m), 1); /* quotient in the high half */
+    return _mm256_blend_epi32(even, odd, 0xAA);
+}
+
 SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 {
     simd_layout layout = {(int)k};
@@ -83,13 +121,9 @@ SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layou
     for (uint32_t i = 0; i < k; ++i) x[i] = _mm256_cvtps_pd(_mm_setr_ps(w[i], w[k + i], w[2 * k + i], w[3 * k + i]));
 }
 
-/* (float)(q * (1/s)) per component, as sp_grid_to_weights does, stored as four vertices. */
-SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+/* Four vertices of k floats from k component vectors: transposes by shuffles and blends. */
+SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, float* out)
 {
-    __m128 w[SP_MAX_INFLUENCES];
-    (void)layout;
-    SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) w[i] = _mm256_cvtpd_ps(_mm256_mul_pd(q[i], v_splat(inverse)));
     if (k == 4) { /* a 4x4 transpose in two registers: six shuffles, not eight, and two stores */
         __m256 even = _mm256_insertf128_ps(_mm256_castps128_ps256(w[0]), w[2], 1); /* components 0 | 2 */
         __m256 odd = _mm256_insertf128_ps(_mm256_castps128_ps256(w[1]), w[3], 1);  /* components 1 | 3 */
@@ -97,16 +131,52 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
         __m256d lo = _mm256_castps_pd(_mm256_unpacklo_ps(even, odd)), hi = _mm256_castps_pd(_mm256_unpackhi_ps(even, odd));
         _mm256_storeu_ps(out, _mm256_castpd_ps(_mm256_permute4x64_pd(lo, 0xD8)));     /* vertices 0, 1 */
         _mm256_storeu_ps(out + 8, _mm256_castpd_ps(_mm256_permute4x64_pd(hi, 0xD8))); /* vertices 2, 3 */
-        return;
+    } else if (k == 3) {
+        /* Output float f holds component f % 3 of vertex f / 3. Each component is permuted once
+         * so that, in each of the three output vectors, the lanes it owns hold the right vertex
+         * (component 0 owns lanes 0, 3 of the first vector, 2 of the second, 1 of the third:
+         * vertices 0, 1 | 2 | 3), and blends pick the owner of each lane. */
+        __m128 p0 = _mm_permute_ps(w[0], _MM_SHUFFLE(1, 2, 3, 0)); /* vertices 0 3 2 1 */
+        __m128 p1 = _mm_permute_ps(w[1], _MM_SHUFFLE(2, 3, 0, 1)); /* 1 0 3 2 */
+        __m128 p2 = _mm_permute_ps(w[2], _MM_SHUFFLE(3, 0, 1, 2)); /* 2 1 0 3 */
+        _mm_storeu_ps(out, _mm_blend_ps(_mm_blend_ps(p0, p1, 0x2), p2, 0x4));
+        _mm_storeu_ps(out + 4, _mm_blend_ps(_mm_blend_ps(p1, p2, 0x2), p0, 0x4));
+        _mm_storeu_ps(out + 8, _mm_blend_ps(_mm_blend_ps(p2, p0, 0x2), p1, 0x4));
+    } else {
+        _mm_storeu_ps(out, _mm_unpacklo_ps(w[0], w[1]));
+        _mm_storeu_ps(out + 4, _mm_unpackhi_ps(w[0], w[1]));
     }
-    float lanes[SP_MAX_INFLUENCES][BLOCK];
+}
+
+/* (float)(q * (1/s)) per component, as sp_grid_to_weights does, stored as four vertices. */
+SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+{
+    __m128 w[SP_MAX_INFLUENCES];
+    (void)layout;
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) _mm_storeu_ps(lanes[i], w[i]);
+    for (uint32_t i = 0; i < k; ++i) w[i] = _mm256_cvtpd_ps(_mm256_mul_pd(q[i], v_splat(inverse)));
+    store_floats(w, k, out);
+}
+
+/* The low halves of eight codes, in order (codes below 2^31 there). */
+SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
+{
+    __m256 a = _mm256_loadu_ps((const float*)codes), b = _mm256_loadu_ps((const float*)(codes + 4));
+    __m256 halves = _mm256_shuffle_ps(a, b, 0x88); /* codes 0 1 4 5 | 2 3 6 7 */
+    return _mm256_castpd_si256(_mm256_permute4x64_pd(_mm256_castps_pd(halves), 0xD8));
+}
+
+/* store_weights of eight vertices from int32 components: two blocks of doubles (exact). */
+SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+{
+    vec low[SP_MAX_INFLUENCES], high[SP_MAX_INFLUENCES];
     SP_UNROLL
-    for (uint32_t lane = 0; lane < BLOCK; ++lane) {
-        SP_UNROLL
-        for (uint32_t i = 0; i < k; ++i) out[lane * k + i] = lanes[i][lane];
+    for (uint32_t i = 0; i < k; ++i) {
+        low[i] = _mm256_cvtepi32_pd(_mm256_castsi256_si128(q[i]));
+        high[i] = _mm256_cvtepi32_pd(_mm256_extracti128_si256(q[i], 1));
     }
+    store_weights(low, k, inverse, layout, out);
+    store_weights(high, k, inverse, layout, out + BLOCK * k);
 }
 
 /* u64 < 2^52 <-> double by placing it in the mantissa of 2^52 (AVX2 has no 64-bit conversion);

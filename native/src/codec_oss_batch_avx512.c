@@ -53,6 +53,43 @@ SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m) { return v_add_where(c,
 SP_INLINE SIMD_FN vec c_threshold(vec d) { return d; }
 SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
 
+/* Sixteen float or int32 lanes for decode in 32-bit lanes. */
+#define NBLOCK 16
+#define NARROW_CHUNK 8 /* DECODE_CHUNK's vertices */
+typedef __m512 nvec;
+typedef __m512i nint;
+typedef __mmask16 nmask;
+SP_INLINE SIMD_FN nvec f_splat(float x) { return _mm512_set1_ps(x); }
+SP_INLINE SIMD_FN nvec f_add(nvec a, nvec b) { return _mm512_add_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sub(nvec a, nvec b) { return _mm512_sub_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_mul(nvec a, nvec b) { return _mm512_mul_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sqrt(nvec a) { return _mm512_sqrt_ps(a); }
+SP_INLINE SIMD_FN nvec f_fmadd(nvec a, nvec b, nvec c) { return _mm512_fmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nvec f_fnmadd(nvec a, nvec b, nvec c) { return _mm512_fnmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nint i_splat(int32_t x) { return _mm512_set1_epi32(x); }
+SP_INLINE SIMD_FN nint i_add(nint a, nint b) { return _mm512_add_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_sub(nint a, nint b) { return _mm512_sub_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_mullo(nint a, nint b) { return _mm512_mullo_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_max(nint a, nint b) { return _mm512_max_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_min(nint a, nint b) { return _mm512_min_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_shr2(nint a) { return _mm512_srai_epi32(a, 2); }
+SP_INLINE SIMD_FN nmask i_gt(nint a, nint b) { return _mm512_cmpgt_epi32_mask(a, b); }
+SP_INLINE SIMD_FN nmask n_or(nmask a, nmask b) { return (nmask)(a | b); }
+SP_INLINE SIMD_FN unsigned n_bits(nmask a) { return a; }
+SP_INLINE SIMD_FN nvec i_to_f(nint a) { return _mm512_cvtepi32_ps(a); }
+SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm512_cvttps_epi32(a); } /* NaN and overflow: INT32_MIN */
+SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm512_castps_si512(a); }
+SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm512_castsi512_ps(a); }
+
+/* floor(a / 9) for 0 <= a < 2^33, as the AVX2 path (codec_oss_batch_avx2.c). */
+SP_INLINE SIMD_FN nint i_div9(nint a)
+{
+    __m512i m = _mm512_set1_epi32(954437177);
+    __m512i even = _mm512_srli_epi64(_mm512_mul_epu32(a, m), 33);
+    __m512i odd = _mm512_srli_epi64(_mm512_mul_epu32(_mm512_srli_epi64(a, 32), m), 1);
+    return _mm512_mask_blend_epi32((__mmask16)0xAAAA, even, odd);
+}
+
 /* Indices between 8 vertices of k floats (AoS, as two 16-float registers: floats 0..15 and
  * floats 8k-16..8k-1, overlapping for k < 4) and component pairs (c, c + 1) of the 8 vertices
  * (SoA, one register per pair: component c in the low half). */
@@ -109,6 +146,26 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
     if (k > 2)
         _mm512_mask_storeu_ps(out + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
                               _mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1]));
+}
+
+/* The low halves of sixteen codes, in order. */
+SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
+{
+    __m256i low = _mm512_cvtepi64_epi32(_mm512_loadu_si512(codes)), high = _mm512_cvtepi64_epi32(_mm512_loadu_si512(codes + 8));
+    return _mm512_inserti64x4(_mm512_castsi256_si512(low), high, 1);
+}
+
+/* store_weights of sixteen vertices from int32 components: two blocks of doubles (exact). */
+SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+{
+    vec low[SP_MAX_INFLUENCES], high[SP_MAX_INFLUENCES];
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) {
+        low[i] = _mm512_cvtepi32_pd(_mm512_castsi512_si256(q[i]));
+        high[i] = _mm512_cvtepi32_pd(_mm512_extracti64x4_epi64(q[i], 1));
+    }
+    store_weights(low, k, inverse, layout, out);
+    store_weights(high, k, inverse, layout, out + BLOCK * k);
 }
 
 SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes)

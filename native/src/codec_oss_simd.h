@@ -25,6 +25,12 @@
  *   load_weights, store_weights (AoS floats <-> K vectors), load_codes, store_codes (u64),
  *   store_counts (lane values as bytes), codes_valid (every code of some blocks <= max_code)
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
+ * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
+ *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
+ *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
+ *   i_shr2 (arithmetic >> 2), i_div9 (floor(a / 9), 0 <= a < 2^31), i_gt, n_or, n_bits,
+ *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
+ *   load_codes32 (the low halves of NBLOCK codes), store_weights32 (as store_weights)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -330,11 +336,136 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
 }
 
+/* ---- decode in 32-bit lanes ------------------------------------------------------------- */
+
+/*
+ * Narrow codes (K = 3 up to N = NARROW_MAX_N3, K = 4 up to NARROW_MAX_N4: codes of up to 24
+ * and 25 bits) decode in int32 / float lanes, twice as many a register as doubles. The exact
+ * parts run in int32, where every intermediate is an integer below 2^31: the row base
+ * ((4B + 2 - 3j) j + 1) / 4 < (4B + 2)^2 / 12, the row root's argument apex^2 - 12 w, the layer
+ * numerator 9 u(k) + r < 2^31 (its floor by 9 through a 32 x 32-bit product, i_div9); the row
+ * and layer estimates run in float, as estimates only: an estimate that misses (far rarer than
+ * in double, but not never) fails the same exact row check and is redone by the scalar code.
+ * The weights are the double products of the other paths (store_weights), so bit-identical.
+ */
+#define NARROW_MAX_N3 8192 /* apex^2 and 12 w < 2^28.1; codes < 2^24.5 */
+#define NARROW_MAX_N4 1024 /* 9 u((N + 1) / 2) < 2^29.1, 8 (N + 1)^3 < 2^33.1 (float); codes < 2^26 */
+
+SP_INLINE int narrow_decode(const sp_codec* codec, uint32_t k)
+{
+    return (k == 3 && codec->n <= NARROW_MAX_N3) || (k == 4 && codec->n <= NARROW_MAX_N4);
+}
+
+/* s_B(j) = ((4B + 2 - 3j) j + 1) / 4 (floor: the numerator is positive) with 4B + 2 = 2 apex. */
+SP_INLINE SIMD_FN nint n_row_base(nint apex, nint three_j, nint j)
+{
+    nint slope = i_sub(i_add(apex, apex), three_j);
+    return i_shr2(i_add(i_mullo(slope, j), i_splat(1)));
+}
+
+/* cbrt(x) + 1/cbrt(x) in float to ~1e-7 (x >= 1; garbage lanes for others, which the row check
+ * rejects): z ~ x^(-1/3) by the exponent/3 bit trick and two third-order steps
+ * z (1 + r/3 + 2r^2/9), r = 1 - x z^3, then c = x z^2 and c + z. */
+SP_INLINE SIMD_FN nvec n_root_sum(nvec x)
+{
+    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
+    nvec z = i_as_f(i_sub(i_splat(1419916032), third));
+    SP_UNROLL
+    for (int step = 0; step < 2; ++step) {
+        nvec xz = f_mul(x, z), r = f_fnmadd(xz, f_mul(z, z), f_splat(1.0f));
+        z = f_fmadd(f_mul(z, r), f_fmadd(r, f_splat(2.0f / 9.0f), f_splat(1.0f / 3.0f)), z);
+    }
+    return f_fmadd(f_mul(x, z), z, z);
+}
+
+/* The layer of each code and its index inside the layer, as layer_estimate and layer_base. */
+SP_INLINE SIMD_FN nint n_layer(double n, nint code, nint* rest)
+{
+    double m = n + 1;
+    nvec x = f_fnmadd(i_to_f(code), f_splat(144.0f), f_splat((float)(8 * m * m * m + 12 * m * m - 106)));
+    nvec estimate = f_fnmadd(n_root_sum(x), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4)));
+    nint layer = i_min(i_max(i_trunc(estimate), i_splat(0)), i_splat((int32_t)(((uint64_t)n + 1) / 2 - 1)));
+    /* 9 u(k) + r = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2; the inner factor is positive */
+    nint a = i_sub(i_add(layer, i_add(layer, i_add(layer, layer))), i_splat((int32_t)(6 * n + 9)));
+    a = i_add(i_mullo(a, layer), i_splat((int32_t)(3 * n * n + 9 * n + 6)));
+    a = i_add(i_mullo(a, layer), i_splat(2));
+    *rest = i_sub(code, i_div9(a));
+    return layer;
+}
+
+/* The row estimate (row_estimate: the mirrored root for w + 7/8, apex^2 + 3 - 10.5 - 12 w),
+ * the argument exact in int32, the root in float; trunc and floor agree after the clamp. */
+SP_INLINE SIMD_FN nint n_row_estimate(nint apex, nint w)
+{
+    nint mirrored = i_sub(i_mullo(apex, apex), i_add(i_mullo(w, i_splat(12)), i_splat(8)));
+    nvec root = f_sqrt(f_add(i_to_f(mirrored), f_splat(0.5f)));
+    return i_max(i_trunc(f_mul(f_sub(i_to_f(apex), root), f_splat(1.0f / 3.0f))), i_splat(0)); /* NaN: 0 */
+}
+
+/* Grid components of one block from layer, row estimate and rest (row_offset's check: the lanes
+ * where i = w - s_B(j) is not in [0, (2B - 3j) / 2) come back as bits). */
+SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex, nint row, nint w, nint* q)
+{
+    nint three_j = i_add(row, i_add(row, row));
+    nint i = i_sub(w, n_row_base(apex, three_j, row));
+    nint last = i_sub(i_sub(apex, i_splat(3)), three_j); /* 2B - 2 - 3j */
+    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i_add(i, i), last)));
+    if (k == 4) q[3] = layer;
+    q[2] = k == 4 ? i_add(row, layer) : row;
+    q[1] = i_add(i, q[2]);
+    nint sum = i_add(q[1], q[2]);
+    q[0] = i_sub(i_splat((int32_t)(2 * (n - 1))), k == 4 ? i_add(sum, layer) : sum);
+    return missed;
+}
+
+/* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there. */
+SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                           uint32_t k, const simd_layout* layout)
+{
+    double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
+    nint layer[NARROW_CHUNK], rest[NARROW_CHUNK], apex[NARROW_CHUNK], row[NARROW_CHUNK];
+    unsigned missed[NARROW_CHUNK], any = 0; /* lanes as bits */
+    for (size_t b = 0; b < blocks; ++b) {
+        rest[b] = load_codes32(codes + b * NBLOCK);
+        if (k == 4) layer[b] = n_layer(n, rest[b], &rest[b]);
+    }
+    for (size_t b = 0; b < blocks; ++b) {
+        apex[b] = i_splat((int32_t)(2 * n + 1));
+        if (k == 4) apex[b] = i_sub(apex[b], i_add(i_add(layer[b], layer[b]), i_add(layer[b], layer[b]))); /* 2(N - 2k) + 1 */
+        row[b] = n_row_estimate(apex[b], rest[b]);
+    }
+    for (size_t b = 0; b < blocks; ++b) {
+        nint q[SP_MAX_INFLUENCES];
+        missed[b] = n_unpack(n, k, k == 4 ? layer[b] : i_splat(0), apex[b], row[b], rest[b], q);
+        any |= missed[b];
+        store_weights32(q, k, inverse, layout, weights + b * NBLOCK * k);
+    }
+    for (size_t b = 0; any && b < blocks; ++b)
+        for (size_t lane = b * NBLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+}
+
+/* The chunks of narrow codes up to the first chunk holding an invalid code (decode_blocks
+ * finds it block by block). */
+SP_INLINE SIMD_FN size_t decode_narrow(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                       uint32_t k, const simd_layout* layout)
+{
+    size_t v = 0;
+    while (v + NBLOCK <= count) {
+        size_t blocks = (count - v) / NBLOCK;
+        if (blocks > NARROW_CHUNK) blocks = NARROW_CHUNK;
+        if (!codes_valid(codes + v, blocks * (NBLOCK / BLOCK), codec->max_code)) break;
+        decode_chunk_narrow(codec, codes + v, blocks, weights + v * k, k, layout);
+        v += blocks * NBLOCK;
+    }
+    return v;
+}
+
 SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                                        uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    size_t v = 0;
+    size_t v = narrow_decode(codec, k) ? decode_narrow(codec, codes, count, weights, k, &layout) : 0;
     while (v + BLOCK <= count) {
         size_t blocks = (count - v) / BLOCK, valid = 0;
         if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;

@@ -142,13 +142,14 @@ static void random_tuples(void)
     free(w), free(codes);
 }
 
-/* N at and just past the largest the vector paths accept (exact there, scalar beyond), and
+/* N at and just past the largest the vector paths accept (exact there, scalar beyond), and the
+ * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024; double lanes beyond), and
  * codes at every layer and row start/end there, where the root estimates are off by one, and
  * the last codes, where the layer estimate's cube root argument is smallest. */
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}};
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}, {3, 8192}, {4, 1024}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -177,10 +178,12 @@ static void range_edges(void)
 /* Every layer's first and last codes (and their neighbours) for K = 4, every row's for K = 3,
  * from small budgets to the large ones: where the layer and row estimates are closest to
  * wrong (the AVX2 layer estimate's float cube root is good to ~1e-8, so its misses gather
- * there for large N), each lane decoded or redone as the scalar code decodes it. */
+ * there for large N; the 32-bit lanes' float roots, to 24 and 25 bits, miss more), each lane
+ * decoded or redone as the scalar code decodes it. */
 static void estimate_boundaries(void)
 {
-    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
+    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 24}, {3, 32}, {4, 12}, {4, 22},
+                                                          {4, 25}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
     for (size_t e = 0; e < sizeof(cases) / sizeof(cases[0]); ++e) {
         sp_codec c;
         uint32_t k = cases[e].k;
