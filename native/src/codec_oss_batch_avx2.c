@@ -166,17 +166,50 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
     return _mm256_castpd_si256(_mm256_permute4x64_pd(_mm256_castps_pd(halves), 0xD8));
 }
 
-/* store_weights of eight vertices from int32 components: two blocks of doubles (exact). */
-SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+/* Eight vertices of k floats from k component vectors (store_floats on eight lanes). */
+SP_INLINE SIMD_FN void store_floats8(const __m256* w, uint32_t k, float* out)
 {
-    vec low[SP_MAX_INFLUENCES], high[SP_MAX_INFLUENCES];
+    if (k == 4) {
+        __m256 t0 = _mm256_unpacklo_ps(w[0], w[1]), t1 = _mm256_unpackhi_ps(w[0], w[1]); /* c0 c1 of v0 v1 | v4 v5 ... */
+        __m256 t2 = _mm256_unpacklo_ps(w[2], w[3]), t3 = _mm256_unpackhi_ps(w[2], w[3]);
+        __m256 v04 = _mm256_shuffle_ps(t0, t2, 0x44), v15 = _mm256_shuffle_ps(t0, t2, 0xEE); /* vertex 0 | 4, 1 | 5 */
+        __m256 v26 = _mm256_shuffle_ps(t1, t3, 0x44), v37 = _mm256_shuffle_ps(t1, t3, 0xEE);
+        _mm256_storeu_ps(out, _mm256_permute2f128_ps(v04, v15, 0x20));
+        _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(v26, v37, 0x20));
+        _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(v04, v15, 0x31));
+        _mm256_storeu_ps(out + 24, _mm256_permute2f128_ps(v26, v37, 0x31));
+    } else if (k == 3) { /* as store_floats: component c owns lanes f = c (mod 3) of the three outputs */
+        __m256 p0 = _mm256_permutevar8x32_ps(w[0], _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+        __m256 p1 = _mm256_permutevar8x32_ps(w[1], _mm256_setr_epi32(5, 0, 3, 6, 1, 4, 7, 2));
+        __m256 p2 = _mm256_permutevar8x32_ps(w[2], _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
+        _mm256_storeu_ps(out, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x92), p2, 0x24));
+        _mm256_storeu_ps(out + 8, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x24), p2, 0x49));
+        _mm256_storeu_ps(out + 16, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x49), p2, 0x92));
+    } else {
+        __m256 lo = _mm256_unpacklo_ps(w[0], w[1]), hi = _mm256_unpackhi_ps(w[0], w[1]); /* v0 v1 | v4 v5, v2 v3 | v6 v7 */
+        _mm256_storeu_ps(out, _mm256_permute2f128_ps(lo, hi, 0x20));
+        _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+    }
+}
+
+/*
+ * store_weights of eight vertices from int32 components 0 <= q <= s < 2^24, in float lanes:
+ * (float)(q * (1/s)) in double is the correctly rounded q/s here (its error, below 2^-52
+ * relative, is smaller than the distance 1/(s M) >= 2^-48 of q/s from any float midpoint
+ * M 2^-t, M < 2^25, and q/s is no midpoint itself), and so is Markstein's correction of
+ * y = q r, r = 1/s in float: y + r (q - s y), the residual exact by FMA. test_batch checks it
+ * for every q <= s of every N the 32-bit lanes take.
+ */
+SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
+{
+    __m256 w[SP_MAX_INFLUENCES], s = _mm256_set1_ps((float)scale), r = _mm256_set1_ps(1.0f / (float)scale);
+    (void)layout;
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        low[i] = _mm256_cvtepi32_pd(_mm256_castsi256_si128(q[i]));
-        high[i] = _mm256_cvtepi32_pd(_mm256_extracti128_si256(q[i], 1));
+        __m256 x = _mm256_cvtepi32_ps(q[i]), y = _mm256_mul_ps(x, r);
+        w[i] = _mm256_fmadd_ps(_mm256_fnmadd_ps(y, s, x), r, y);
     }
-    store_weights(low, k, inverse, layout, out);
-    store_weights(high, k, inverse, layout, out + BLOCK * k);
+    store_floats8(w, k, out);
 }
 
 /* u64 < 2^52 <-> double by placing it in the mantissa of 2^52 (AVX2 has no 64-bit conversion);

@@ -156,8 +156,9 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
 }
 
 /* store_weights of sixteen vertices from int32 components: two blocks of doubles (exact). */
-SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
 {
+    double inverse = 1.0 / scale;
     vec low[SP_MAX_INFLUENCES], high[SP_MAX_INFLUENCES];
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {

@@ -30,7 +30,7 @@
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
  *   i_shr2 (arithmetic >> 2), i_div9 (floor(a / 9), 0 <= a < 2^31), i_gt, n_or, n_bits,
  *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
- *   load_codes32 (the low halves of NBLOCK codes), store_weights32 (as store_weights)
+ *   load_codes32 (the low halves of NBLOCK codes), store_weights32 (as store_weights, of the scale)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -422,7 +422,7 @@ SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex,
 SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
                                            uint32_t k, const simd_layout* layout)
 {
-    double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
+    double n = (double)codec->n, scale = (double)codec->scale;
     nint layer[NARROW_CHUNK], rest[NARROW_CHUNK], apex[NARROW_CHUNK], row[NARROW_CHUNK];
     unsigned missed[NARROW_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
@@ -438,7 +438,7 @@ SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t
         nint q[SP_MAX_INFLUENCES];
         missed[b] = n_unpack(n, k, k == 4 ? layer[b] : i_splat(0), apex[b], row[b], rest[b], q);
         any |= missed[b];
-        store_weights32(q, k, inverse, layout, weights + b * NBLOCK * k);
+        store_weights32(q, k, scale, layout, weights + b * NBLOCK * k);
     }
     for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * NBLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)

@@ -201,6 +201,21 @@ static void estimate_boundaries(void)
     }
 }
 
+/* Every weight q / s the 32-bit lanes compute (every q <= s = 2(N - 1) of every N they take,
+ * K = 3 up to 8192, K = 4 up to 1024): the first row of the first layer, codes 0..N - 1, holds
+ * q1 = 0..N - 1 and q0 = N - 1..s, so it reaches every q. */
+static void narrow_weights(void)
+{
+    uint64_t* codes = malloc(8192 * sizeof(uint64_t));
+    for (uint64_t v = 0; v < 8192; ++v) codes[v] = v;
+    for (uint32_t k = 3; k <= 4; ++k)
+        for (uint64_t n = 2; n <= (k == 3 ? 8192u : 1024u); ++n) {
+            sp_codec c = oss(k, n);
+            if (compare_decode(&c, codes, (size_t)n, "narrow weights")) break;
+        }
+    free(codes);
+}
+
 /* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero,
  * not summing to 1): the vector lanes must hand them to the scalar code. Not here: sums near 0
  * (denormal weights, w and -w), which scale x past 2^63, where the scalar fast path is
@@ -328,6 +343,7 @@ int main(void)
         odd_weights();
         range_edges();
         estimate_boundaries();
+        narrow_weights();
         random_tuples();
     }
     return check_report("test_batch");
