@@ -155,18 +155,28 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
     return _mm512_inserti64x4(_mm512_castsi256_si512(low), high, 1);
 }
 
-/* store_weights of sixteen vertices from int32 components: two blocks of doubles (exact). */
+/* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes
+ * by Markstein's correction of q r, the correctly rounded q/s as the double product (see
+ * store_weights32 in codec_oss_batch_avx2.c), then each half as store_weights stores it. */
 SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
 {
-    double inverse = 1.0 / scale;
-    vec low[SP_MAX_INFLUENCES], high[SP_MAX_INFLUENCES];
+    __m512 w[SP_MAX_INFLUENCES], s = _mm512_set1_ps((float)scale), r = _mm512_set1_ps(1.0f / (float)scale);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        low[i] = _mm512_cvtepi32_pd(_mm512_castsi512_si256(q[i]));
-        high[i] = _mm512_cvtepi32_pd(_mm512_extracti64x4_epi64(q[i], 1));
+        __m512 x = _mm512_cvtepi32_ps(q[i]), y = _mm512_mul_ps(x, r);
+        w[i] = _mm512_fmadd_ps(_mm512_fnmadd_ps(y, s, x), r, y);
     }
-    store_weights(low, k, inverse, layout, out);
-    store_weights(high, k, inverse, layout, out + BLOCK * k);
+    if (k == 3) w[3] = w[2]; /* the unused pair half */
+    SP_UNROLL
+    for (uint32_t half = 0; half < 2; ++half) { /* pairs (c, c + 1) of vertices 8 half .. 8 half + 7 */
+        int select = half ? 0xEE : 0x44;
+        __m512 pair0 = _mm512_shuffle_f32x4(w[0], w[1], select), pair1 = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], select) : pair0;
+        float* at = out + half * BLOCK * k;
+        _mm512_storeu_ps(at, _mm512_permutex2var_ps(pair0, layout->aos[0], pair1));
+        if (k > 2)
+            _mm512_mask_storeu_ps(at + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
+                                  _mm512_permutex2var_ps(pair0, layout->aos[1], pair1));
+    }
 }
 
 SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes)
