@@ -62,7 +62,7 @@ SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold
 
 /* Eight float or int32 lanes for decode in 32-bit lanes. */
 #define NBLOCK 8
-#define NARROW_CHUNK 8 /* DECODE_CHUNK's vertices */
+#define NARROW_CHUNK 16 /* blocks a stage: K = 3, 4 ~5% faster than 8; 32 no faster */
 typedef __m256 nvec;
 typedef __m256i nint;
 typedef __m256i nmask;

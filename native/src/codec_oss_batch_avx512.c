@@ -55,7 +55,7 @@ SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold
 
 /* Sixteen float or int32 lanes for decode in 32-bit lanes. */
 #define NBLOCK 16
-#define NARROW_CHUNK 8 /* DECODE_CHUNK's vertices */
+#define NARROW_CHUNK 16 /* blocks a stage (256 vertices): K = 4 ~3% faster than 8 */
 typedef __m512 nvec;
 typedef __m512i nint;
 typedef __mmask16 nmask;

@@ -365,32 +365,37 @@ SP_INLINE SIMD_FN nint n_row_base(nint apex, nint three_j, nint j)
 
 /* cbrt(x) + 1/cbrt(x) in float to ~1e-7 (x >= 1; garbage lanes for others, which the row check
  * rejects): z ~ x^(-1/3) by the exponent/3 bit trick and two third-order steps
- * z (1 + r/3 + 2r^2/9), r = 1 - x z^3, then c = x z^2 and c + z. */
-SP_INLINE SIMD_FN nvec n_root_sum(nvec x)
+ * z (1 + r/3 + 2r^2/9), r = 1 - x z^3 (n_root_step), then c = x z^2 and c + z. */
+SP_INLINE SIMD_FN nvec n_root_step(nvec x, nvec z)
 {
-    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
-    nvec z = i_as_f(i_sub(i_splat(1419916032), third));
-    SP_UNROLL
-    for (int step = 0; step < 2; ++step) {
-        nvec xz = f_mul(x, z), r = f_fnmadd(xz, f_mul(z, z), f_splat(1.0f));
-        z = f_fmadd(f_mul(z, r), f_fmadd(r, f_splat(2.0f / 9.0f), f_splat(1.0f / 3.0f)), z);
-    }
-    return f_fmadd(f_mul(x, z), z, z);
+    nvec xz = f_mul(x, z), r = f_fnmadd(xz, f_mul(z, z), f_splat(1.0f));
+    return f_fmadd(f_mul(z, r), f_fmadd(r, f_splat(2.0f / 9.0f), f_splat(1.0f / 3.0f)), z);
 }
 
-/* The layer of each code and its index inside the layer, as layer_estimate and layer_base. */
-SP_INLINE SIMD_FN nint n_layer(double n, nint code, nint* rest)
+/* The layer root's argument x for each code (layer_argument) and a first z ~ x^(-1/3). */
+SP_INLINE SIMD_FN nvec n_layer_start(double n, nint code, nvec* z)
 {
     double m = n + 1;
     nvec x = f_fnmadd(i_to_f(code), f_splat(144.0f), f_splat((float)(8 * m * m * m + 12 * m * m - 106)));
-    nvec estimate = f_fnmadd(n_root_sum(x), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4)));
-    nint layer = i_min(i_max(i_trunc(estimate), i_splat(0)), i_splat((int32_t)(((uint64_t)n + 1) / 2 - 1)));
-    /* 9 u(k) + r = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2; the inner factor is positive */
-    nint a = i_sub(i_add(layer, i_add(layer, i_add(layer, layer))), i_splat((int32_t)(6 * n + 9)));
-    a = i_add(i_mullo(a, layer), i_splat((int32_t)(3 * n * n + 9 * n + 6)));
-    a = i_add(i_mullo(a, layer), i_splat(2));
-    *rest = i_sub(code, i_div9(a));
-    return layer;
+    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
+    *z = n_root_step(x, i_as_f(i_sub(i_splat(1419916032), third)));
+    return x;
+}
+
+/* The layer of each code from x and z, as layer_estimate. */
+SP_INLINE SIMD_FN nint n_layer_finish(double n, nvec x, nvec z)
+{
+    z = n_root_step(x, z);
+    nvec estimate = f_fnmadd(f_fmadd(f_mul(x, z), z, z), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4)));
+    return i_min(i_max(i_trunc(estimate), i_splat(0)), i_splat((int32_t)(((uint64_t)n + 1) / 2 - 1)));
+}
+
+/* u(k) as layer_base: 9 u(k) + r = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2, the inner factor
+ * positive; four_k = 4k. */
+SP_INLINE SIMD_FN nint n_layer_base(double n, nint layer, nint four_k)
+{
+    nint a = i_add(i_mullo(i_sub(four_k, i_splat((int32_t)(6 * n + 9))), layer), i_splat((int32_t)(3 * n * n + 9 * n + 6)));
+    return i_div9(i_add(i_mullo(a, layer), i_splat(2)));
 }
 
 /* The row estimate (row_estimate: the mirrored root for w + 7/8, apex^2 + 3 - 10.5 - 12 w),
@@ -425,13 +430,20 @@ SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t
     double n = (double)codec->n, scale = (double)codec->scale;
     nint layer[NARROW_CHUNK], rest[NARROW_CHUNK], apex[NARROW_CHUNK], row[NARROW_CHUNK];
     unsigned missed[NARROW_CHUNK], any = 0; /* lanes as bits */
+    nvec x[NARROW_CHUNK], z[NARROW_CHUNK];
     for (size_t b = 0; b < blocks; ++b) {
         rest[b] = load_codes32(codes + b * NBLOCK);
-        if (k == 4) layer[b] = n_layer(n, rest[b], &rest[b]);
+        if (k == 4) x[b] = n_layer_start(n, rest[b], &z[b]);
     }
-    for (size_t b = 0; b < blocks; ++b) {
+    if (k == 4)
+        for (size_t b = 0; b < blocks; ++b) layer[b] = n_layer_finish(n, x[b], z[b]);
+    for (size_t b = 0; b < blocks; ++b) { /* the layer base in a stage of its own: the root's chain is long */
         apex[b] = i_splat((int32_t)(2 * n + 1));
-        if (k == 4) apex[b] = i_sub(apex[b], i_add(i_add(layer[b], layer[b]), i_add(layer[b], layer[b]))); /* 2(N - 2k) + 1 */
+        if (k == 4) {
+            nint four_k = i_add(i_add(layer[b], layer[b]), i_add(layer[b], layer[b]));
+            rest[b] = i_sub(rest[b], n_layer_base(n, layer[b], four_k));
+            apex[b] = i_sub(apex[b], four_k); /* 2(N - 2k) + 1 */
+        }
         row[b] = n_row_estimate(apex[b], rest[b]);
     }
     for (size_t b = 0; b < blocks; ++b) {
