@@ -63,23 +63,39 @@ SP_INLINE SIMD_FN vec layer_base(double n, vec k)
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
-/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain. */
+/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain.
+ * The scalar sums from 0 + w0, which differs from w0 only for w0 = -0, and then only if all
+ * weights are -0 does the sum: scale = -inf instead of +inf, and every x NaN either way (a
+ * lane the rounding redoes). */
 SP_INLINE SIMD_FN vec quantize_scale(const vec* w, uint32_t k, double s)
 {
-    vec sum = v_zero();
+    vec sum = w[0];
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) sum = v_add(sum, w[i]); /* 0 + w0 first: keeps -0 as the scalar does */
+    for (uint32_t i = 1; i < k; ++i) sum = v_add(sum, w[i]);
     return v_div(v_splat(s), sum);
 }
 
-/* sp_grid_quantize's floors x = max(w s / sum, 0) -> q = trunc(x), remainder = x - q, same
- * operations in the same order; returns the deficit s - sum of q. */
+/* The lanes whose weights are sorted and non-negative (no NaN), as bits: the only ones the
+ * vector encode keeps. There w s / sum >= 0 (or NaN, where the sum is 0), so the scalar's
+ * max(x, 0) is x (-0 for -0, equal for every later use), and the floors are sorted too, which
+ * the rounding keeps (for equal floors the earlier remainder is not smaller, so it wins), so
+ * the index is the scalar's: for unsorted q the scalar wraps around. */
+SP_INLINE SIMD_FN unsigned weights_ordered(const vec* w, uint32_t k)
+{
+    mask ok = m_ge(w[k - 1], v_zero());
+    SP_UNROLL
+    for (uint32_t i = 1; i < k; ++i) ok = m_and(ok, m_ge(w[i - 1], w[i]));
+    return m_bits(ok);
+}
+
+/* sp_grid_quantize's floors x = w s / sum -> q = trunc(x), remainder = x - q, same operations
+ * in the same order for the ordered lanes; returns the deficit s - sum of q. */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
     vec deficit = v_splat(s);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_max(v_mul(w[i], scale), v_zero()); /* max returns its second operand for NaN: x > 0 ? x : 0 */
+        vec x = v_mul(w[i], scale);
         q[i] = v_trunc(x);
         remainder[i] = v_sub(x, q[i]);
         deficit = v_sub(deficit, q[i]);
@@ -114,7 +130,7 @@ SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remain
     return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
 }
 
-/* sp_oss_pack on sorted lanes (the caller masks unsorted ones: the scalar wraps around there). */
+/* sp_oss_pack on sorted lanes (the caller masks the others). */
 SP_INLINE SIMD_FN vec pack_block(const vec* q, uint32_t k, double n)
 {
     if (k == 2) return q[1];
@@ -133,14 +149,11 @@ SP_INLINE SIMD_FN void store_significant(const vec* q, uint32_t k, uint8_t* out)
     store_counts(count, out);
 }
 
-/* The rounding of one block's floors and the sorted check: the lanes the vector code cannot
- * prove exact, as bits. */
-SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q)
+/* The rounding of one block's floors: the lanes the vector code cannot prove exact (outside
+ * `ordered`, or past the fast path's deficits), as bits. */
+SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q, unsigned ordered)
 {
-    mask ok = quantize_round(k, deficit, remainder, q);
-    SP_UNROLL
-    for (uint32_t i = 1; i < k; ++i) ok = m_and(ok, m_ge(q[i - 1], q[i]));
-    return ~m_bits(ok) & ((1u << BLOCK) - 1);
+    return ~(m_bits(quantize_round(k, deficit, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
 }
 
 /* The indices (and counts) of one block's sorted lanes. */
@@ -162,20 +175,21 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights,
     double s = (double)codec->scale, n = (double)codec->n;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK], deficit[ENCODE_CHUNK];
     vec q[ENCODE_CHUNK][SP_MAX_INFLUENCES], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
-    unsigned missed[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, s);
+        ordered[b] = weights_ordered(w[b], k);
     }
     if (ENCODE_FUSED)
         for (size_t b = 0; b < blocks; ++b) {
             deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
         }
     else {
         for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-        for (size_t b = 0; b < blocks; ++b) missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+        for (size_t b = 0; b < blocks; ++b) missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
         for (size_t b = 0; b < blocks; ++b)
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
