@@ -12,7 +12,7 @@ SP_FP_CONTRACT_OFF
 #define SIMD_FN SP_TARGET("avx2,fma")
 #define SIMD_NAME(name) sp_oss_##name##_avx2
 #define BLOCK 4
-#define ENCODE_CHUNK 8
+#define ENCODE_CHUNK 16 /* K = 3 encode ~3% faster than 8 */
 #define ENCODE_FUSED 0 /* in one stage K = 4 encode spills and runs ~25% slower */
 #define DECODE_CHUNK 16 /* K = 4 decode ~10% faster than with 8; 32 no faster */
 
@@ -108,13 +108,15 @@ SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layout* layout, vec* x)
 {
     (void)layout;
-    if (k == 4) {
-        __m128 r0 = _mm_loadu_ps(w), r1 = _mm_loadu_ps(w + 4), r2 = _mm_loadu_ps(w + 8), r3 = _mm_loadu_ps(w + 12);
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        x[0] = _mm256_cvtps_pd(r0);
-        x[1] = _mm256_cvtps_pd(r1);
-        x[2] = _mm256_cvtps_pd(r2);
-        x[3] = _mm256_cvtps_pd(r3);
+    if (k == 4) { /* two 8-float loads, two unpacks and two permutes: components 0 | 1 and 2 | 3 */
+        __m256 v01 = _mm256_loadu_ps(w), v23 = _mm256_loadu_ps(w + 8);
+        __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7); /* (v0 v2 v0 v2 | v1 v3 v1 v3) -> v0 v1 v2 v3 */
+        __m256 c01 = _mm256_permutevar8x32_ps(_mm256_unpacklo_ps(v01, v23), order);
+        __m256 c23 = _mm256_permutevar8x32_ps(_mm256_unpackhi_ps(v01, v23), order);
+        x[0] = _mm256_cvtps_pd(_mm256_castps256_ps128(c01));
+        x[1] = _mm256_cvtps_pd(_mm256_extractf128_ps(c01, 1));
+        x[2] = _mm256_cvtps_pd(_mm256_castps256_ps128(c23));
+        x[3] = _mm256_cvtps_pd(_mm256_extractf128_ps(c23, 1));
         return;
     }
     SP_UNROLL
