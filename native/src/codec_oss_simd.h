@@ -289,7 +289,7 @@ SP_INLINE SIMD_FN vec row_offset(vec bottom, vec j, vec w, mask* ok)
 SP_INLINE SIMD_FN void unpacked_block(double n, uint32_t k, vec layer, vec row, vec i, vec* q)
 {
     if (k == 4) q[3] = layer;
-    q[2] = v_add(row, layer);
+    q[2] = k == 4 ? v_add(row, layer) : row;
     q[1] = v_add(i, q[2]);
     vec sum = v_add(q[1], q[2]);
     q[0] = v_sub(v_splat(2 * (n - 1)), k == 4 ? v_add(sum, layer) : sum);
@@ -323,11 +323,8 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
             if (k == 4) {
                 rest[b] = v_sub(rest[b], layer_base(n, layer[b]));
                 bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(n));
-            } else {
-                layer[b] = v_zero();
-                bottom[b] = v_splat(n);
             }
-            row[b] = row_estimate(bottom[b], rest[b]);
+            row[b] = row_estimate(k == 4 ? bottom[b] : v_splat(n), rest[b]); /* K = 3: one triangle, constants */
         }
     for (size_t b = 0; b < blocks; ++b) {
         vec q[SP_MAX_INFLUENCES];
@@ -337,8 +334,8 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
             missed[b] = 0;
         } else {
             mask ok;
-            vec i = row_offset(bottom[b], row[b], rest[b], &ok);
-            unpacked_block(n, k, layer[b], row[b], i, q);
+            vec i = row_offset(k == 4 ? bottom[b] : v_splat(n), row[b], rest[b], &ok);
+            unpacked_block(n, k, k == 4 ? layer[b] : v_zero(), row[b], i, q);
             missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
         }
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
