@@ -175,7 +175,7 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights,
     double s = (double)codec->scale, n = (double)codec->n;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK], deficit[ENCODE_CHUNK];
     vec q[ENCODE_CHUNK][SP_MAX_INFLUENCES], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
-    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, s);
@@ -184,17 +184,15 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights,
     if (ENCODE_FUSED)
         for (size_t b = 0; b < blocks; ++b) {
             deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
+            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
         }
     else {
         for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-        for (size_t b = 0; b < blocks; ++b) missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
+        for (size_t b = 0; b < blocks; ++b) any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
         for (size_t b = 0; b < blocks; ++b)
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
-    unsigned any = 0;
-    for (size_t b = 0; b < blocks; ++b) any |= missed[b];
     for (size_t b = 0; any && b < blocks; ++b) /* any: most chunks have no lane to redo */
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
@@ -309,7 +307,7 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
     double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
     vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
     root z[DECODE_CHUNK];
-    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK);
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
@@ -336,12 +334,10 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
             mask ok;
             vec i = row_offset(k == 4 ? bottom[b] : v_splat(n), row[b], rest[b], &ok);
             unpacked_block(n, k, k == 4 ? layer[b] : v_zero(), row[b], i, q);
-            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
+            any |= missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
         }
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
-    unsigned any = 0;
-    for (size_t b = 0; b < blocks; ++b) any |= missed[b];
     for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
