@@ -160,12 +160,29 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
     store_floats(w, k, out);
 }
 
-/* The low halves of eight codes, in order (codes below 2^31 there). */
-SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
+/* Codes <= max_code < 2^31: zero high halves, and low halves not above it unsigned (compared as
+ * signed with the sign bits flipped); the lanes past either or-ed together. */
+typedef struct code_check {
+    __m256i over, top;
+} code_check;
+
+SP_INLINE SIMD_FN code_check check_start(uint64_t max_code)
+{
+    code_check check = {_mm256_setzero_si256(), _mm256_set1_epi32((int32_t)(max_code ^ 0x80000000u))};
+    return check;
+}
+
+SP_INLINE SIMD_FN int check_passed(const code_check* check) { return _mm256_testz_si256(check->over, check->over); }
+
+/* The low halves of eight codes, in order. */
+SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
 {
     __m256 a = _mm256_loadu_ps((const float*)codes), b = _mm256_loadu_ps((const float*)(codes + 4));
-    __m256 halves = _mm256_shuffle_ps(a, b, 0x88); /* codes 0 1 4 5 | 2 3 6 7 */
-    return _mm256_castpd_si256(_mm256_permute4x64_pd(_mm256_castps_pd(halves), 0xD8));
+    __m256i low = _mm256_castps_si256(_mm256_shuffle_ps(a, b, 0x88)); /* codes 0 1 4 5 | 2 3 6 7 */
+    __m256i high = _mm256_castps_si256(_mm256_shuffle_ps(a, b, 0xDD));
+    __m256i past = _mm256_cmpgt_epi32(_mm256_xor_si256(low, _mm256_set1_epi32(INT32_MIN)), check->top);
+    check->over = _mm256_or_si256(check->over, _mm256_or_si256(high, past));
+    return _mm256_permute4x64_epi64(low, 0xD8);
 }
 
 /* Eight vertices of k floats from k component vectors (store_floats on eight lanes). */

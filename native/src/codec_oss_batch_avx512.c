@@ -148,11 +148,29 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
                               _mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1]));
 }
 
-/* The low halves of sixteen codes, in order. */
-SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes)
+/* Codes <= max_code: the largest code seen, compared once. */
+typedef struct code_check {
+    __m512i high;
+    uint64_t max_code;
+} code_check;
+
+SP_INLINE SIMD_FN code_check check_start(uint64_t max_code)
 {
-    __m256i low = _mm512_cvtepi64_epi32(_mm512_loadu_si512(codes)), high = _mm512_cvtepi64_epi32(_mm512_loadu_si512(codes + 8));
-    return _mm512_inserti64x4(_mm512_castsi256_si512(low), high, 1);
+    code_check check = {_mm512_setzero_si512(), max_code};
+    return check;
+}
+
+SP_INLINE SIMD_FN int check_passed(const code_check* check)
+{
+    return !_mm512_cmpgt_epu64_mask(check->high, _mm512_set1_epi64((int64_t)check->max_code));
+}
+
+/* The low halves of sixteen codes, in order. */
+SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
+{
+    __m512i first = _mm512_loadu_si512(codes), second = _mm512_loadu_si512(codes + 8);
+    check->high = _mm512_max_epu64(check->high, _mm512_max_epu64(first, second));
+    return _mm512_inserti64x4(_mm512_castsi256_si512(_mm512_cvtepi64_epi32(first)), _mm512_cvtepi64_epi32(second), 1);
 }
 
 /* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes

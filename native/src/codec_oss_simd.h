@@ -30,7 +30,9 @@
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
  *   i_shr2 (arithmetic >> 2), i_div9 (floor(a / 9), 0 <= a < 2^31), i_gt, n_or, n_bits,
  *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
- *   load_codes32 (the low halves of NBLOCK codes), store_weights32 (as store_weights, of the scale)
+ *   code_check, check_start(max_code < 2^31), load_codes32(codes, check) (the low halves of
+ *   NBLOCK codes, each checked <= max_code), check_passed, store_weights32 (as store_weights,
+ *   of the scale)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -430,18 +432,22 @@ SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex,
     return missed;
 }
 
-/* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there. */
-SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
-                                           uint32_t k, const simd_layout* layout)
+/* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there;
+ * the codes are checked against max_code as they are loaded, and a chunk holding an invalid
+ * one is left to the caller, unwritten (returns 0). */
+SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                          uint32_t k, const simd_layout* layout)
 {
     double n = (double)codec->n, scale = (double)codec->scale;
     nint layer[NARROW_CHUNK], rest[NARROW_CHUNK], apex[NARROW_CHUNK], row[NARROW_CHUNK];
     unsigned missed[NARROW_CHUNK], any = 0; /* lanes as bits */
     nvec x[NARROW_CHUNK], z[NARROW_CHUNK];
+    code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
-        rest[b] = load_codes32(codes + b * NBLOCK);
+        rest[b] = load_codes32(codes + b * NBLOCK, &check);
         if (k == 4) x[b] = n_layer_start(n, rest[b], &z[b]);
     }
+    if (!check_passed(&check)) return 0; /* nothing written yet */
     if (k == 4)
         for (size_t b = 0; b < blocks; ++b) layer[b] = n_layer_finish(n, x[b], z[b]);
     for (size_t b = 0; b < blocks; ++b) { /* the layer base in a stage of its own: the root's chain is long */
@@ -462,6 +468,7 @@ SP_INLINE SIMD_FN void decode_chunk_narrow(const sp_codec* codec, const uint64_t
     for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * NBLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+    return 1;
 }
 
 /* The chunks of narrow codes up to the first chunk holding an invalid code (decode_blocks
@@ -473,8 +480,7 @@ SP_INLINE SIMD_FN size_t decode_narrow(const sp_codec* codec, const uint64_t* co
     while (v + NBLOCK <= count) {
         size_t blocks = (count - v) / NBLOCK;
         if (blocks > NARROW_CHUNK) blocks = NARROW_CHUNK;
-        if (!codes_valid(codes + v, blocks * (NBLOCK / BLOCK), codec->max_code)) break;
-        decode_chunk_narrow(codec, codes + v, blocks, weights + v * k, k, layout);
+        if (!decode_chunk_narrow(codec, codes + v, blocks, weights + v * k, k, layout)) break;
         v += blocks * NBLOCK;
     }
     return v;

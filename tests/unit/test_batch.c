@@ -269,11 +269,13 @@ static void invalid_codes(void)
         sp_codec c;
         CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
         for (size_t at = 0; at < COUNT; ++at)
-            for (int pass = 0; pass < 2; ++pass) {
+            for (int pass = 0; pass < 3; ++pass) {
                 uint64_t codes[COUNT];
                 float w[COUNT * 4], ref[4];
+                /* just past the range, all ones, and a code whose low 32 bits are negative as int32 */
+                const uint64_t invalid[3] = {c.max_code + 1, UINT64_MAX, ((uint64_t)1 << 31) + 5};
                 for (size_t v = 0; v < COUNT; ++v) codes[v] = rng_next() % (c.max_code + 1);
-                codes[at] = pass ? UINT64_MAX : c.max_code + 1;
+                codes[at] = invalid[pass];
                 if (at + 3 < COUNT) codes[at + 3] = c.max_code + 7; /* a later one is not reported */
                 for (size_t i = 0; i < COUNT * 4; ++i) w[i] = -7.0f;
                 size_t bad = (size_t)-1;
