@@ -160,15 +160,17 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
     store_floats(w, k, out);
 }
 
-/* Codes <= max_code < 2^31: zero high halves, and low halves not above it unsigned (compared as
- * signed with the sign bits flipped); the lanes past either or-ed together. */
+/* Codes <= max_code, compared unsigned as signed with the sign bits flipped: 64-bit lanes, or
+ * for max_code < 2^31 zero high halves and low halves in 32-bit lanes; the lanes past it or-ed
+ * together. */
 typedef struct code_check {
-    __m256i over, top;
+    __m256i over, top64, top32;
 } code_check;
 
 SP_INLINE SIMD_FN code_check check_start(uint64_t max_code)
 {
-    code_check check = {_mm256_setzero_si256(), _mm256_set1_epi32((int32_t)(max_code ^ 0x80000000u))};
+    code_check check = {_mm256_setzero_si256(), _mm256_set1_epi64x((int64_t)(max_code ^ (uint64_t)INT64_MIN)),
+                        _mm256_set1_epi32((int32_t)((uint32_t)max_code ^ 0x80000000u))};
     return check;
 }
 
@@ -180,7 +182,7 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
     __m256 a = _mm256_loadu_ps((const float*)codes), b = _mm256_loadu_ps((const float*)(codes + 4));
     __m256i low = _mm256_castps_si256(_mm256_shuffle_ps(a, b, 0x88)); /* codes 0 1 4 5 | 2 3 6 7 */
     __m256i high = _mm256_castps_si256(_mm256_shuffle_ps(a, b, 0xDD));
-    __m256i past = _mm256_cmpgt_epi32(_mm256_xor_si256(low, _mm256_set1_epi32(INT32_MIN)), check->top);
+    __m256i past = _mm256_cmpgt_epi32(_mm256_xor_si256(low, _mm256_set1_epi32(INT32_MIN)), check->top32);
     check->over = _mm256_or_si256(check->over, _mm256_or_si256(high, past));
     return _mm256_permute4x64_epi64(low, 0xD8);
 }
@@ -233,10 +235,11 @@ SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, 
 
 /* u64 < 2^52 <-> double by placing it in the mantissa of 2^52 (AVX2 has no 64-bit conversion);
  * lanes outside that range are garbage, and only lanes the scalar code redoes get there. */
-SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes)
+SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)
 {
     __m256d magic = v_splat(4503599627370496.0);
     __m256i raw = _mm256_loadu_si256((const __m256i*)codes);
+    check->over = _mm256_or_si256(check->over, _mm256_cmpgt_epi64(_mm256_xor_si256(raw, _mm256_set1_epi64x(INT64_MIN)), check->top64));
     return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(raw, _mm256_castpd_si256(magic))), magic);
 }
 
@@ -255,17 +258,11 @@ SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
     memcpy(out, &packed, sizeof(packed));
 }
 
-/* Every code of `blocks` blocks <= max_code: unsigned compares as signed with the sign bits
- * flipped, their results or-ed and tested once. */
-SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, size_t blocks, uint64_t max_code)
+SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, uint64_t max_code)
 {
-    __m256i flip = _mm256_set1_epi64x(INT64_MIN), top = _mm256_set1_epi64x((int64_t)(max_code ^ (uint64_t)INT64_MIN));
-    __m256i over = _mm256_setzero_si256();
-    for (size_t b = 0; b < blocks; ++b) {
-        __m256i raw = _mm256_loadu_si256((const __m256i*)(codes + b * BLOCK));
-        over = _mm256_or_si256(over, _mm256_cmpgt_epi64(_mm256_xor_si256(raw, flip), top));
-    }
-    return _mm256_testz_si256(over, over);
+    code_check check = check_start(max_code);
+    load_codes(codes, &check);
+    return check_passed(&check);
 }
 
 /*

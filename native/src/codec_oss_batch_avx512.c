@@ -197,9 +197,11 @@ SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, 
     }
 }
 
-SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes)
+SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)
 {
-    return _mm512_cvtepu64_pd(_mm512_loadu_si512(codes)); /* exact below 2^53 */
+    __m512i raw = _mm512_loadu_si512(codes);
+    check->high = _mm512_max_epu64(check->high, raw);
+    return _mm512_cvtepu64_pd(raw); /* exact below 2^53 */
 }
 
 SP_INLINE SIMD_FN void store_codes(uint64_t* codes, vec x)
@@ -212,11 +214,9 @@ SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
     _mm_storel_epi64((__m128i*)out, _mm512_cvtepi64_epi8(_mm512_cvttpd_epi64(count)));
 }
 
-SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, size_t blocks, uint64_t max_code)
+SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, uint64_t max_code)
 {
-    __m512i top = _mm512_set1_epi64((int64_t)max_code), high = _mm512_setzero_si512();
-    for (size_t b = 0; b < blocks; ++b) high = _mm512_max_epu64(high, _mm512_loadu_si512(codes + b * BLOCK));
-    return !_mm512_cmpgt_epu64_mask(high, top);
+    return !_mm512_cmpgt_epu64_mask(_mm512_loadu_si512(codes), _mm512_set1_epi64((int64_t)max_code));
 }
 
 /*

@@ -22,17 +22,18 @@
  *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
  *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
  *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
- *   load_weights, store_weights (AoS floats <-> K vectors), load_codes, store_codes (u64),
- *   store_counts (lane values as bytes), codes_valid (every code of some blocks <= max_code)
+ *   load_weights, store_weights (AoS floats <-> K vectors), store_codes (u64),
+ *   code_check, check_start(max_code), load_codes(codes, check) (each checked <= max_code),
+ *   check_passed, store_counts (lane values as bytes), codes_valid (every code of a block
+ *   <= max_code)
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
  * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
  *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
  *   i_shr2 (arithmetic >> 2), i_div9 (floor(a / 9), 0 <= a < 2^31), i_gt, n_or, n_bits,
  *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
- *   code_check, check_start(max_code < 2^31), load_codes32(codes, check) (the low halves of
- *   NBLOCK codes, each checked <= max_code), check_passed, store_weights32 (as store_weights,
- *   of the scale)
+ *   load_codes32(codes, check) (the low halves of NBLOCK codes, each checked <= max_code,
+ *   which is below 2^31 there), store_weights32 (as store_weights, of the scale)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -295,22 +296,25 @@ SP_INLINE SIMD_FN void unpacked_block(double n, uint32_t k, vec layer, vec row, 
     q[0] = v_sub(v_splat(2 * (n - 1)), k == 4 ? v_add(sum, layer) : sum);
 }
 
-/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes <= max_code, in stages
- * (the layer root's two halves, the row, the rest), then the scalar redo of the lanes it missed.
- * Every array entry is written in a stage before a later one reads it.
+/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages (the layer
+ * root's two halves, the row, the rest), then the scalar redo of the lanes it missed. Every
+ * array entry is written in a stage before a later one reads it. The codes are checked against
+ * max_code as they are loaded: a chunk with an invalid one is left unwritten (returns 0).
  *
  * The layer needs no check of its own: with k clamped to the layers, the row check accepts
  * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
  * and then (k, row, i) is the one tuple whose index is code. */
-SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
-                                    uint32_t k, const simd_layout* layout)
+SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                   uint32_t k, const simd_layout* layout)
 {
     double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
     vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
     root z[DECODE_CHUNK];
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
-    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK);
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK, &check);
+    if (!check_passed(&check)) return 0; /* nothing written yet */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = layer_argument(n, rest[b]);
@@ -343,6 +347,7 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
     for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+    return 1;
 }
 
 /* ---- decode in 32-bit lanes ------------------------------------------------------------- */
@@ -494,12 +499,13 @@ SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const uint64_t* co
     while (v + BLOCK <= count) {
         size_t blocks = (count - v) / BLOCK, valid = 0;
         if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
-        if (codes_valid(codes + v, blocks, codec->max_code)) valid = blocks; /* the common case: one test a chunk */
-        else
-            while (valid < blocks && codes_valid(codes + v + valid * BLOCK, 1, codec->max_code)) ++valid;
-        if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
-        decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
-        v += valid * BLOCK;
+        if (!decode_chunk(codec, codes + v, blocks, weights + v * k, k, &layout)) {
+            /* an invalid code: the blocks before its block, then the scalar loop reports it */
+            while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
+            if (valid) decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
+            return v + valid * BLOCK;
+        }
+        v += blocks * BLOCK;
     }
     return v;
 }
