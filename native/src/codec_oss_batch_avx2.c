@@ -1,6 +1,7 @@
 /*
- * AVX2 + FMA3 primitives of the OSS batch driver (codec_oss_simd.h): four double lanes, masks
- * as all-ones lanes, the AoS weights moved with 4x4 transposes.
+ * AVX2 + FMA3 primitives of the OSS batch driver (codec_oss_simd.h): four double lanes (eight
+ * float / int32 lanes for narrow decode), masks as all-ones lanes, the AoS weights moved with
+ * shuffles, permutes and blends.
  */
 #include "codec_internal.h"
 

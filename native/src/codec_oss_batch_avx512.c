@@ -1,7 +1,7 @@
 /*
- * AVX-512 (F, DQ, VL) primitives of the OSS batch driver (codec_oss_simd.h): eight double lanes,
- * compare masks in mask registers, the AoS weights moved in and out with two-source permutes,
- * and rcp14 estimates in the layer root.
+ * AVX-512 (F, DQ, VL) primitives of the OSS batch driver (codec_oss_simd.h): eight double lanes
+ * (sixteen float / int32 lanes for narrow decode), compare masks in mask registers, the AoS
+ * weights moved in and out with two-source permutes, and rcp14 estimates in the layer root.
  */
 #include "codec_internal.h"
 

@@ -7,10 +7,11 @@
  * sp_oss_unpack + sp_grid_to_weights): the rounding runs in double lanes with the scalar's
  * exact operation order, and the OSS index arithmetic runs in double lanes too, where every
  * intermediate is an integer or a quarter small enough (codec_oss_batch.c) to be exact in any order (Horner forms,
- * explicit FMAs). Decode's layer and row *estimates* differ from the scalar ones (no layer
- * square root, no divisions, shifted arguments): exact integer checks decide every lane. A lane
- * whose inputs leave that exact regime (odd weights, a code the estimate misses) is redone by
- * the scalar code, so the vector code only ever has to be right where it claims to be.
+ * explicit FMAs); narrow codes decode in int32 / float lanes instead (see "decode in 32-bit
+ * lanes"). Decode's layer and row *estimates* differ from the scalar ones (no layer square
+ * root, no divisions, shifted arguments): exact integer checks decide every lane. A lane whose
+ * inputs leave that exact regime (odd weights, a code the estimate misses) is redone by the
+ * scalar code, so the vector code only ever has to be right where it claims to be.
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN):
  *   vec, mask          BLOCK double lanes and a lane mask; BLOCK, ENCODE_CHUNK, DECODE_CHUNK,
@@ -358,9 +359,10 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const uint64_t* codes,
  * parts run in int32, where every intermediate is an integer below 2^31: the row base
  * ((4B + 2 - 3j) j + 1) / 4 < (4B + 2)^2 / 12, the row root's argument apex^2 - 12 w, the layer
  * numerator 9 u(k) + r < 2^31 (its floor by 9 through a 32 x 32-bit product, i_div9); the row
- * and layer estimates run in float, as estimates only: an estimate that misses (far rarer than
- * in double, but not never) fails the same exact row check and is redone by the scalar code.
- * The weights are the double products of the other paths (store_weights), so bit-identical.
+ * and layer estimates run in float, as estimates only: an estimate that misses (more often than
+ * in double: ~3e-4 of random K = 3 codes at 24 bits) fails the same exact row check and is
+ * redone by the scalar code. The weights are the correctly rounded q/s (store_weights32), which
+ * the double product of the scalar code is too for these q and s.
  */
 #define NARROW_MAX_N3 8192 /* apex^2 and 12 w < 2^28.1; codes < 2^24.5 */
 #define NARROW_MAX_N4 1024 /* 9 u((N + 1) / 2) < 2^29.1, 8 (N + 1)^3 < 2^33.1 (float); codes < 2^26 */
