@@ -185,15 +185,17 @@ SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, 
         w[i] = _mm512_fmadd_ps(_mm512_fnmadd_ps(y, s, x), r, y);
     }
     if (k == 3) w[3] = w[2]; /* the unused pair half */
+    /* pairs (c, c + 1) of vertices 0..7 (the low halves: 0x44) and 8..15 (the high ones: 0xEE) */
+    __m512 pairs[2][2] = {{_mm512_shuffle_f32x4(w[0], w[1], 0x44)}, {_mm512_shuffle_f32x4(w[0], w[1], 0xEE)}};
+    pairs[0][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0x44) : pairs[0][0];
+    pairs[1][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0xEE) : pairs[1][0];
     SP_UNROLL
-    for (uint32_t half = 0; half < 2; ++half) { /* pairs (c, c + 1) of vertices 8 half .. 8 half + 7 */
-        int select = half ? 0xEE : 0x44;
-        __m512 pair0 = _mm512_shuffle_f32x4(w[0], w[1], select), pair1 = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], select) : pair0;
+    for (uint32_t half = 0; half < 2; ++half) {
         float* at = out + half * BLOCK * k;
-        _mm512_storeu_ps(at, _mm512_permutex2var_ps(pair0, layout->aos[0], pair1));
+        _mm512_storeu_ps(at, _mm512_permutex2var_ps(pairs[half][0], layout->aos[0], pairs[half][1]));
         if (k > 2)
             _mm512_mask_storeu_ps(at + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
-                                  _mm512_permutex2var_ps(pair0, layout->aos[1], pair1));
+                                  _mm512_permutex2var_ps(pairs[half][0], layout->aos[1], pairs[half][1]));
     }
 }
 
