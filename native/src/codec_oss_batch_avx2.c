@@ -214,6 +214,24 @@ SP_INLINE SIMD_FN void store_floats8(const __m256* w, uint32_t k, float* out)
     }
 }
 
+/* store_weights of two blocks, one after the other: K = 3 as eight vertices (store_floats8
+ * takes fewer shuffles than two store_floats), K = 2, 4 as two blocks. */
+SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t k, double inverse,
+                                  const simd_layout* layout, float* out)
+{
+    if (k != 3) {
+        store_weights(first, k, inverse, layout, out);
+        store_weights(second, k, inverse, layout, out + BLOCK * k);
+        return;
+    }
+    __m256 w[3];
+    SP_UNROLL
+    for (uint32_t i = 0; i < 3; ++i)
+        w[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(_mm256_mul_pd(first[i], v_splat(inverse)))),
+                                    _mm256_cvtpd_ps(_mm256_mul_pd(second[i], v_splat(inverse))), 1);
+    store_floats8(w, 3, out);
+}
+
 /*
  * store_weights of eight vertices from int32 components 0 <= q <= s < 2^24, in float lanes:
  * (float)(q * (1/s)) in double is the correctly rounded q/s here (its error, below 2^-52

@@ -173,6 +173,14 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
     return _mm512_inserti64x4(_mm512_castsi256_si512(_mm512_cvtepi64_epi32(first)), _mm512_cvtepi64_epi32(second), 1);
 }
 
+/* store_weights of two blocks, one after the other. */
+SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t k, double inverse,
+                                  const simd_layout* layout, float* out)
+{
+    store_weights(first, k, inverse, layout, out);
+    store_weights(second, k, inverse, layout, out + BLOCK * k);
+}
+
 /* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes
  * by Markstein's correction of q r, the correctly rounded q/s as the double product (see
  * store_weights32 in codec_oss_batch_avx2.c), then each half as store_weights stores it. */

@@ -23,7 +23,8 @@
  *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
  *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
  *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
- *   load_weights, store_weights (AoS floats <-> K vectors), store_codes (u64),
+ *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
+ *   store_codes (u64),
  *   code_check, check_start(max_code), load_codes(codes, check) (each checked <= max_code),
  *   check_passed, store_counts (lane values as bytes), codes_valid (every code of a block
  *   <= max_code)
@@ -297,6 +298,21 @@ SP_INLINE SIMD_FN void unpacked_block(double n, uint32_t k, vec layer, vec row, 
     q[0] = v_sub(v_splat(2 * (n - 1)), k == 4 ? v_add(sum, layer) : sum);
 }
 
+/* The last stage's grid components of one block (layer and bottom unused for K = 2, 3) and
+ * the lanes the row check rejects, as bits. */
+SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bottom, vec row, vec rest, vec* q)
+{
+    if (k == 2) {
+        q[1] = rest;
+        q[0] = v_sub(v_splat(2 * (n - 1)), rest);
+        return 0;
+    }
+    mask ok;
+    vec i = row_offset(k == 4 ? bottom : v_splat(n), row, rest, &ok);
+    unpacked_block(n, k, k == 4 ? layer : v_zero(), row, i, q);
+    return ~m_bits(ok) & ((1u << BLOCK) - 1);
+}
+
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages (the layer
  * root's two halves, the row, the rest), then the scalar redo of the lanes it missed. Every
  * array entry is written in a stage before a later one reads it. The codes are checked against
@@ -331,18 +347,16 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const uint64_t* codes,
             }
             row[b] = row_estimate(k == 4 ? bottom[b] : v_splat(n), rest[b]); /* K = 3: one triangle, constants */
         }
-    for (size_t b = 0; b < blocks; ++b) {
+    size_t b = 0;
+    for (; b + 1 < blocks; b += 2) { /* two blocks a step: store_pair may store them faster together */
+        vec first[SP_MAX_INFLUENCES], second[SP_MAX_INFLUENCES];
+        any |= missed[b] = decoded_block(n, k, layer[b], bottom[b], row[b], rest[b], first);
+        any |= missed[b + 1] = decoded_block(n, k, layer[b + 1], bottom[b + 1], row[b + 1], rest[b + 1], second);
+        store_pair(first, second, k, inverse, layout, weights + b * BLOCK * k);
+    }
+    if (b < blocks) {
         vec q[SP_MAX_INFLUENCES];
-        if (k == 2) {
-            q[1] = rest[b];
-            q[0] = v_sub(v_splat(2 * (n - 1)), rest[b]);
-            missed[b] = 0;
-        } else {
-            mask ok;
-            vec i = row_offset(k == 4 ? bottom[b] : v_splat(n), row[b], rest[b], &ok);
-            unpacked_block(n, k, k == 4 ? layer[b] : v_zero(), row[b], i, q);
-            any |= missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
-        }
+        any |= missed[b] = decoded_block(n, k, layer[b], bottom[b], row[b], rest[b], q);
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
     for (size_t b = 0; any && b < blocks; ++b)
