@@ -120,6 +120,16 @@ SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layou
         x[3] = _mm256_cvtps_pd(_mm256_extractf128_ps(c23, 1));
         return;
     }
+    if (k == 3) { /* store_floats' blends and permutes backwards */
+        __m128 a0 = _mm_loadu_ps(w), a1 = _mm_loadu_ps(w + 4), a2 = _mm_loadu_ps(w + 8);
+        __m128 p0 = _mm_blend_ps(_mm_blend_ps(a0, a2, 0x2), a1, 0x4); /* component 0 of vertices 0 3 2 1 */
+        __m128 p1 = _mm_blend_ps(_mm_blend_ps(a1, a0, 0x2), a2, 0x4); /* 1 0 3 2 */
+        __m128 p2 = _mm_blend_ps(_mm_blend_ps(a2, a1, 0x2), a0, 0x4); /* 2 1 0 3 */
+        x[0] = _mm256_cvtps_pd(_mm_permute_ps(p0, _MM_SHUFFLE(1, 2, 3, 0)));
+        x[1] = _mm256_cvtps_pd(_mm_permute_ps(p1, _MM_SHUFFLE(2, 3, 0, 1)));
+        x[2] = _mm256_cvtps_pd(_mm_permute_ps(p2, _MM_SHUFFLE(3, 0, 1, 2)));
+        return;
+    }
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) x[i] = _mm256_cvtps_pd(_mm_setr_ps(w[i], w[k + i], w[2 * k + i], w[3 * k + i]));
 }
