@@ -110,7 +110,8 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
 
 /*
  * sp_grid_quantize's last step: the deficit goes, one each, to the components with the largest
- * remainders (ties to the lower index), chosen by rank. Returns the lanes the fast path is exact
+ * remainders (ties to the lower index), chosen by rank; q[0], which the index and the
+ * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
  * for: a deficit in [0, k), where the scalar takes the same path. That also bounds every x by
  * s + 1, so floors and deficit are exact: an x past that makes the deficit negative, and one
  * past 2^53 (or infinite) keeps it so under rounding. Other lanes get some q: they are redone.
@@ -131,7 +132,7 @@ SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remain
     }
     vec threshold = c_threshold(deficit), one = v_splat(1.0);
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one);
+    for (uint32_t i = 1; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one); /* q[0] is implied */
     return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
 }
 
