@@ -12,6 +12,8 @@
 
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx512
 
+#define WIDE_ROOT_NEWTON 0 /* its root (a double Newton step) is good to far below half a layer */
+
 typedef __m512i ivec;
 typedef __mmask8 imask;
 

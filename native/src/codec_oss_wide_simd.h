@@ -6,8 +6,8 @@
  * Past the double lanes' exact range (codec_oss_batch.c: layer and row bases past 2^50) the
  * bases run in 64-bit integer lanes. Grid coordinates and codes fit 64 bits, and where an
  * intermediate does not, the arithmetic is modulo 2^64 with a final value below 2^64:
- *   - the row base s_B(j) = floor(((4B + 2 - 3j) j + 1) / 4) from 32-bit partial products
- *     (quarter_product), since a floor by 4 does not commute with a reduction mod 2^64;
+ *   - the row base s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4) as j (N - j) + floor((j + 1)^2 / 4),
+ *     since a floor by 4 does not commute with a reduction mod 2^64;
  *   - the layer base u(k) = (a - r) / 9 with a its numerator mod 2^64, r = a mod 9 (which for a
  *     given N depends only on k mod 3: a table of three in one word), and the exact division as
  *     a product with 9's inverse mod 2^64.
@@ -27,6 +27,7 @@
  *   i_lt (unsigned compare), i_select(m, a, b) = m ? a : b, im_bits (lanes as bits)
  *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
  *   i_from_v (integral doubles in [0, 2^52)), v_select(m, a, b) on double lanes
+ *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
  * and WIDE_NAME(name), the entry points' names.
  */
 
@@ -37,9 +38,9 @@
 typedef struct wide_codec {
     double n, scale;          /* N and the grid 2(N - 1) */
     uint64_t scale_bits;      /* 2(N - 1) */
-    uint64_t row_slope;       /* 4N + 2 (K = 3) */
     uint64_t mirrored;        /* (2N + 1)^2 + 3 mod 2^64 (K = 3) */
-    double mirrored_d, apex, last_row;
+    double mirrored_d, apex, last_row, last_layer;
+    int rounded_rows;         /* apex^2 + 3 reaches 2^62: the row root argument may be rounded */
     uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
     uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
     uint64_t root_argument;      /* 8M^3 + 12M^2 - 106 mod 2^64, M = N + 1 (K = 4) */
@@ -51,10 +52,10 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     uint64_t n = codec->n, m = n + 1, apex = 2 * n + 1; /* wraps for K = 2 past 2^63: unused there */
     wide_codec c;
     c.n = (double)n, c.scale = (double)codec->scale, c.scale_bits = codec->scale;
-    c.row_slope = 4 * n + 2;
     sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(apex), sp_u128_from(apex)), 3);
     c.mirrored = sp_u128_low(square), c.mirrored_d = sp_u128_to_double(square);
-    c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1);
+    c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1), c.last_layer = (double)((n + 1) / 2 - 1);
+    c.rounded_rows = sp_u128_less(sp_u128_pow2(62), square);
     c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
     sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
     sp_u128 root = sp_u128_sub(sp_u128_add(sp_u128_mul_u64(sp_u128_mul_u64(m2, m), 8), sp_u128_mul_u64(m2, 12)),
@@ -71,22 +72,14 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     return c;
 }
 
-/* floor((a b + 1) / 4) mod 2^64 for any a, b: with a = 2^32 ah + al, b likewise,
- * a b + 1 = (al bl + 1) + 2^32 (ah bl + al bh) + 2^64 ah bh, whose last two terms are multiples
- * of 4, so the floor is (al bl + 1) / 4 floored + 2^30 (ah bl + al bh) + 2^62 ah bh (al bl + 1
- * stays below 2^64). */
-SP_INLINE SIMD_FN ivec quarter_product(ivec a, ivec b)
-{
-    ivec ah = i_srl(a, 32), bh = i_srl(b, 32);
-    ivec low = i_srl(i_add(i_mul32(a, b), i_splat(1)), 2);
-    ivec cross = i_add(i_mul32(ah, b), i_mul32(a, bh));
-    return i_add(i_add(low, i_sll(cross, 30)), i_sll(i_mul32(ah, bh), 62));
-}
-
-/* s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4), K = 3 (positive inside the triangle). */
+/* s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4), K = 3: the numerator is 4 j (N - j) + (j + 1)^2, so
+ * s_N(j) = j (N - j) + floor((j + 1)^2 / 4) = j (N - j) + floor((j + 1) / 2) ceil((j + 1) / 2),
+ * below 2^64 inside the triangle: a product mod 2^64 (no floor of a wrapped value) and one of
+ * two halves below 2^32. */
 SP_INLINE SIMD_FN ivec wide_row_base(const wide_codec* c, ivec j)
 {
-    return quarter_product(i_sub(i_splat(c->row_slope), i_add(j, i_add(j, j))), j);
+    ivec one = i_splat(1), half = i_srl(i_add(j, one), 1), half_up = i_srl(i_add(j, i_splat(2)), 1);
+    return i_add(i_mul(j, i_sub(i_splat((uint64_t)c->n), j)), i_mul32(half, half_up));
 }
 
 /* Codes in row j, floor((2N - 3j) / 2) = N - j - (j + 1) / 2 (at least 1 for rows j < rows). */
@@ -190,28 +183,34 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
 
 /* ---- decode ----------------------------------------------------------------------------- */
 
-/* The row estimate of codec_oss_simd.h (for w + 7/8, floored, clamped to the rows) on a 64-bit
- * code w of K = 3: the mirrored root's argument apex^2 + 3 - 12w as root_argument takes it. */
+/*
+ * The estimates here are taken half a row or layer low: the rounded roots are off by far less
+ * than half a step (below 1e-4 of a row for K = 3, ~0.04 of a layer for the AVX2 cube root), so
+ * floored, an estimate is the step or the one before it, and one compare going up settles it.
+ * Lanes it does not settle (none, by that bound) fail the exact checks and are redone.
+ */
+
+/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w, with the mirrored
+ * root's argument apex^2 + 3 - 12w as root_argument takes it, half a row low, floored and
+ * clamped to the rows. */
 SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, ivec w)
 {
     ivec exact = i_sub(i_splat(c->mirrored), i_add(i_sll(w, 3), i_sll(w, 2)));
-    vec mirrored = root_argument(exact, v_fnmadd(v_from_i_rounded(w), v_splat(12.0), v_splat(c->mirrored_d)));
+    vec mirrored = c->rounded_rows
+                       ? root_argument(exact, v_fnmadd(v_from_i_rounded(w), v_splat(12.0), v_splat(c->mirrored_d)))
+                       : v_from_i_rounded(exact);
     vec root = v_sqrt(v_max(v_sub(mirrored, v_splat(10.5)), v_zero()));
-    return clamp_floor(v_mul(v_sub(v_splat(c->apex), root), v_splat(1.0 / 3.0)), v_splat(c->last_row));
+    return clamp_floor(v_fmsub(v_sub(v_splat(c->apex), root), v_splat(1.0 / 3.0), v_splat(0.5)), v_splat(c->last_row));
 }
 
-/* K = 3: the row j of code w from its estimate, one step each way, and i = w - s_N(j) into q;
- * returns the lanes whose (j, i) is not proven right (i outside row j), as bits. A row estimate
- * in [0, rows) never steps outside it for a valid code (s_N(0) = 0, s_N(rows) = the count). */
+/* K = 3: the row j of code w from its estimate (j or j - 1), and i = w - s_N(j), into q; returns
+ * the lanes whose (j, i) is not proven right (i outside row j), as bits. The step up from the
+ * last row never happens for a valid code (s_N(rows) is the code count). */
 SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, ivec w, vec estimate, vec* q)
 {
-    ivec one = i_splat(1), j = i_from_v(estimate), base = wide_row_base(c, j);
-    imask below = i_lt(w, base);
-    j = i_select(below, i_sub(j, one), j);
-    ivec length = wide_row_length(c, j);
-    ivec i = i_sub(w, i_select(below, i_sub(base, length), base));
-    imask above = i_lt(i_sub(length, one), i); /* i >= length */
-    j = i_select(above, i_add(j, one), j);
+    ivec j = i_from_v(estimate), length = wide_row_length(c, j), i = i_sub(w, wide_row_base(c, j));
+    imask above = i_lt(i_sub(length, i_splat(1)), i); /* i >= length: the next row */
+    j = i_select(above, i_add(j, i_splat(1)), j);
     i = i_select(above, i_sub(i, length), i);
     imask ok = i_lt(i, wide_row_length(c, j)); /* also false for a negative i, which wraps */
     unpacked_block(c->n, 3, v_zero(), v_from_i(j), v_from_i(i), q);
@@ -225,18 +224,28 @@ SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, ivec code)
     return root_argument(exact, v_fnmadd(v_from_i_rounded(code), v_splat(144.0), v_splat(c->root_argument_d)));
 }
 
-/* K = 4: rest = code - u(k) for the estimated layer k, one step each way (the AVX2 root misses
- * the layer of ~5 % of the codes near 64 bits), in double lanes: exact while |rest| < 2^51,
- * which *in_range reports (other lanes are redone). The row check then proves the layer. */
+/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate), half a layer low, from its
+ * root t of t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the
+ * widest codes (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic
+ * first (its cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
+SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
+{
+    if (WIDE_ROOT_NEWTON) {
+        vec square = v_mul(t, t);
+        vec excess = v_fmsub(t, v_sub(square, v_splat(3.0)), x);
+        t = v_sub(t, v_div(excess, v_fmsub(square, v_splat(3.0), v_splat(3.0))));
+    }
+    return clamp_floor(v_fnmadd(t, v_splat(0.25), v_splat((2 * c->n + 3) / 4 - 0.5)), v_splat(c->last_layer));
+}
+
+/* K = 4: rest = code - u(k) for the estimated layer k (k or k - 1), one step up, in double
+ * lanes: exact while rest < 2^52, which *in_range reports (other lanes are redone). The row
+ * check then proves the layer: it accepts only a rest inside the layer's triangle. */
 SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, ivec code, vec* layer, unsigned* in_range)
 {
-    ivec offset = i_add(i_sub(code, wide_layer_base(c, i_from_v(*layer))), i_splat((uint64_t)1 << 51));
+    ivec offset = i_sub(code, wide_layer_base(c, i_from_v(*layer)));
     *in_range = im_bits(i_lt(offset, i_splat((uint64_t)1 << 52)));
-    vec rest = v_sub(v_from_i(offset), v_splat(0x1p51));
-    mask below = m_lt(rest, v_zero());
-    *layer = v_add_where(*layer, below, v_splat(-1.0));
-    vec length = wide_layer_length(c->n, *layer);
-    rest = v_add_where(rest, below, length);
+    vec rest = v_from_i(offset), length = wide_layer_length(c->n, *layer);
     mask above = m_ge(rest, length);
     *layer = v_add_where(*layer, above, v_splat(1.0));
     return v_sub(rest, v_add_where(v_zero(), above, length));
@@ -257,8 +266,8 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
             x[b] = wide_layer_argument(c, i_load(codes + b * BLOCK));
             z[b] = root_start(x[b]);
         }
+        for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
         for (size_t b = 0; b < blocks; ++b) {
-            layer[b] = layer_estimate(c->n, root_finish(x[b], z[b]));
             rest[b] = wide_settle_layer(c, i_load(codes + b * BLOCK), &layer[b], &in_range[b]);
             bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
         }
