@@ -130,10 +130,23 @@ SP_INLINE SIMD_FN ivec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
     return i_add(wide_layer_base(c, i_from_v(q[3])), i_from_v(in_layer));
 }
 
-/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then floors,
- * rounding and index per block (the grids here are below 2^50, where sp_grid_quantize rounds in
- * double, so codec_oss_simd.h's rounding is exact), then the scalar redo of the lanes the vector
- * code cannot prove exact. */
+/* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
+ * as bits (the grids here are below 2^50, where sp_grid_quantize rounds in double, so
+ * codec_oss_simd.h's rounding is exact). */
+SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, uint32_t k, uint64_t* codes,
+                                             uint8_t* significant)
+{
+    vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
+    vec deficit = quantize_floor(w, k, c->scale, scale, q, remainder);
+    unsigned missed = round_block(k, deficit, remainder, q);
+    i_store(codes, wide_pack(c, q, k));
+    if (significant) store_significant(q, k, significant);
+    return missed;
+}
+
+/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
+ * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
+ * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes. */
 SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec* c, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
                                          const simd_layout* layout)
@@ -144,12 +157,20 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, c->scale);
     }
-    for (size_t b = 0; b < blocks; ++b) {
-        vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
-        vec deficit = quantize_floor(w[b], k, c->scale, scale[b], q, remainder);
-        missed[b] = round_block(k, deficit, remainder, q);
-        i_store(codes + b * BLOCK, wide_pack(c, q, k));
-        if (significant) store_significant(q, k, significant + b * BLOCK);
+    if (ENCODE_FUSED)
+        for (size_t b = 0; b < blocks; ++b)
+            missed[b] = wide_encode_block(c, w[b], scale[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+    else {
+        vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
+        vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
+        for (size_t b = 0; b < blocks; ++b) {
+            deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
+            missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+        }
+        for (size_t b = 0; b < blocks; ++b) {
+            i_store(codes + b * BLOCK, wide_pack(c, q[b], k));
+            if (significant) store_significant(q[b], k, significant + b * BLOCK);
+        }
     }
     for (size_t b = 0; b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
