@@ -197,8 +197,27 @@ static void path_coverage(const sp_codec* c, int encodes)
     CHECK(sp_oss_batch_supported(c) == encodes);
 }
 
+/* Counts around the block sizes (chunks, blocks of 8 and 4, tails) and pointers off the
+ * vectors' alignment; a zero count with null pointers is fine. */
+static void counts_and_alignment(const sp_codec* c)
+{
+    float w[4 * 72 + 4];
+    uint64_t codes[72 + 2];
+    uint32_t k = c->influences;
+    for (size_t offset = 0; offset < 3; ++offset)
+        for (size_t count = 0; count <= 70; count += 1 + count / 8) {
+            for (size_t v = 0; v < count; ++v) random_weights(k, w + offset + v * k);
+            compare_encode(c, w + offset, count, "count encode");
+            for (size_t v = 0; v < count; ++v) codes[offset + v] = rng_next() % (c->max_code + 1);
+            compare_decode(c, codes + offset, count, "count decode");
+        }
+    CHECK(sp_encode_weights_batch_isa(c, NULL, 0, NULL, NULL, widest) == SP_OK);
+    CHECK(sp_decode_weights_batch_isa(c, NULL, 0, NULL, NULL, widest) == SP_OK);
+}
+
 static void check_codec(const sp_codec* c, int encodes)
 {
+    counts_and_alignment(c);
     path_coverage(c, encodes);
     boundaries(c);
     random_round_trips(c);
