@@ -40,7 +40,6 @@ SP_INLINE SIMD_FN imask i_lt(ivec a, ivec b)
 }
 SP_INLINE SIMD_FN ivec i_select(imask m, ivec a, ivec b) { return _mm256_blendv_epi8(b, a, m); }
 SP_INLINE SIMD_FN unsigned im_bits(imask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
-SP_INLINE SIMD_FN vec v_select(mask m, vec a, vec b) { return _mm256_blendv_pd(b, a, m); }
 
 /* Below 2^52 through the mantissa of 2^52, both ways (garbage elsewhere, as load_codes). */
 SP_INLINE SIMD_FN vec v_from_i(ivec a)
@@ -53,6 +52,15 @@ SP_INLINE SIMD_FN ivec i_from_v(vec x)
 {
     vec magic = v_splat(0x1p52);
     return _mm256_xor_si256(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic));
+}
+
+/* The two 32-bit halves: the low one in the mantissa of 2^52 (no masking: the blend puts 2^52's
+ * high half over it). */
+SP_INLINE SIMD_FN void v_halves(ivec a, vec* high, vec* low)
+{
+    vec magic = v_splat(0x1p52);
+    *high = v_from_i(i_srl(a, 32));
+    *low = v_sub(_mm256_castsi256_pd(_mm256_blend_epi32(a, _mm256_castpd_si256(magic), 0xAA)), magic);
 }
 
 /* Any u64, rounded to nearest: 2^84 + 2^32 hi and 2^52 + lo are exact doubles, so is

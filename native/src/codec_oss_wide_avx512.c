@@ -32,9 +32,13 @@ SP_INLINE SIMD_FN ivec i_mul_u32(ivec a, ivec b) { return i_mul(a, b); }
 SP_INLINE SIMD_FN imask i_lt(ivec a, ivec b) { return _mm512_cmplt_epu64_mask(a, b); }
 SP_INLINE SIMD_FN ivec i_select(imask m, ivec a, ivec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned im_bits(imask m) { return m; }
-SP_INLINE SIMD_FN vec v_select(mask m, vec a, vec b) { return _mm512_mask_blend_pd(m, b, a); }
 SP_INLINE SIMD_FN vec v_from_i(ivec a) { return _mm512_cvtepu64_pd(a); }
 SP_INLINE SIMD_FN vec v_from_i_rounded(ivec a) { return _mm512_cvtepu64_pd(a); } /* rounded to nearest */
+SP_INLINE SIMD_FN void v_halves(ivec a, vec* high, vec* low)
+{
+    *high = _mm512_cvtepu64_pd(i_srl(a, 32));
+    *low = _mm512_cvtepu64_pd(i_and(a, i_splat(0xFFFFFFFFu)));
+}
 SP_INLINE SIMD_FN ivec i_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
 
 #include "codec_oss_wide_simd.h"

@@ -12,10 +12,10 @@
  *     given N depends only on k mod 3: a table of three in one word), and the exact division as
  *     a product with 9's inverse mod 2^64.
  * The root estimates stay in double lanes: their arguments (apex^2 + 3 - 12w for rows,
- * 8M^3 + 12M^2 - 106 - 144 code for layers) are taken modulo 2^64 too, exact where they are
- * below 2^62 (near the apex, where a rounded argument would cancel), rounded where they are
- * larger (where rounding moves the root by far less than a row or layer). An estimate is then
- * settled with exact compares, one step each way; a lane that is still off (or whose rounding
+ * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
+ * (wide_argument), so they are exact where small (near the apex, where a rounded code would
+ * cancel) and rounded once where large (where that moves the root by far less than a step). An
+ * estimate is then settled with exact compares; a lane that is still off (or whose rounding
  * leaves the exact regime, as in codec_oss_simd.h) is redone by the scalar code.
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN), on top of the
@@ -26,7 +26,8 @@
  *   i_mul_u32(a, b)    a b mod 2^64 for b < 2^32; i_mul(a, b): a b mod 2^64
  *   i_lt (unsigned compare), i_select(m, a, b) = m ? a : b, im_bits (lanes as bits)
  *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
- *   i_from_v (integral doubles in [0, 2^52)), v_select(m, a, b) on double lanes
+ *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), i_from_v (integral doubles
+ *   in [0, 2^52))
  *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
  * and WIDE_NAME(name), the entry points' names.
  */
@@ -38,14 +39,21 @@
 typedef struct wide_codec {
     double n, scale;          /* N and the grid 2(N - 1) */
     uint64_t scale_bits;      /* 2(N - 1) */
-    uint64_t mirrored;        /* (2N + 1)^2 + 3 mod 2^64 (K = 3) */
-    double mirrored_d, apex, last_row, last_layer;
-    int rounded_rows;         /* apex^2 + 3 reaches 2^62: the row root argument may be rounded */
+    double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
+    double apex, last_row, last_layer;
     uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
     uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
-    uint64_t root_argument;      /* 8M^3 + 12M^2 - 106 mod 2^64, M = N + 1 (K = 4) */
-    double root_argument_d;
+    double root_high, root_low;  /* 8M^3 + 12M^2 - 106 (M = N + 1) as two exact doubles (K = 4) */
 } wide_codec;
+
+/* a < 2^73 as high + low, both exact doubles: high = a with its low 20 bits cleared (at most 53
+ * significant bits), low = those 20 bits. */
+static void split_exactly(sp_u128 a, double* high, double* low)
+{
+    uint64_t top = (sp_u128_high(a) << 44) | (sp_u128_low(a) >> 20);
+    *high = (double)top * 0x1p20;
+    *low = (double)(sp_u128_low(a) & 0xFFFFF);
+}
 
 static wide_codec wide_codec_for(const sp_codec* codec)
 {
@@ -53,14 +61,14 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     wide_codec c;
     c.n = (double)n, c.scale = (double)codec->scale, c.scale_bits = codec->scale;
     sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(apex), sp_u128_from(apex)), 3);
-    c.mirrored = sp_u128_low(square), c.mirrored_d = sp_u128_to_double(square);
+    split_exactly(square, &c.mirrored_high, &c.mirrored_low);
+    c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
     c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1), c.last_layer = (double)((n + 1) / 2 - 1);
-    c.rounded_rows = sp_u128_less(sp_u128_pow2(62), square);
     c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
     sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
     sp_u128 root = sp_u128_sub(sp_u128_add(sp_u128_mul_u64(sp_u128_mul_u64(m2, m), 8), sp_u128_mul_u64(m2, 12)),
                                sp_u128_from(106));
-    c.root_argument = sp_u128_low(root), c.root_argument_d = sp_u128_to_double(root);
+    split_exactly(root, &c.root_high, &c.root_low);
     /* 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 mod 9 with N mod 9 and k mod 3 for N and k: the first
      * term is 3 times something taken mod 3, the second 4k^3 + 6k mod 9, and (k + 3)^3 = k^3 mod 9. */
     int64_t nm = (int64_t)(n % 9);
@@ -110,11 +118,16 @@ SP_INLINE SIMD_FN vec wide_layer_length(double n, vec k)
     return v_floor(v_mul(v_fmadd(b, v_add(b, v_splat(1.0)), v_splat(1.5)), v_splat(1.0 / 3.0)));
 }
 
-/* A root's argument: `exact` (the value mod 2^64) where the rounded one says it is below 2^62,
- * so below 2^64 for certain, else `rounded`, whose error (~2^17) is then relatively tiny. */
-SP_INLINE SIMD_FN vec root_argument(ivec exact, vec rounded)
+/* high + low - factor a for a code a (factor 12 or 144, high + low < 2^73 from split_exactly):
+ * with a = 2^32 ah + al, high - (factor 2^32) ah is exact (a multiple of 2^20 below 2^73), the
+ * rest rounds only where the sum is past 2^53. So exact for small results, where the roots'
+ * arguments cancel, and within 2^-52 of it otherwise. */
+SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, ivec a)
 {
-    return v_select(m_lt(rounded, v_splat(0x1p62)), v_from_i_rounded(exact), rounded);
+    vec a_high, a_low;
+    v_halves(a, &a_high, &a_low);
+    vec top = v_add(v_fnmadd(a_high, v_splat(factor * 0x1p32), v_splat(high)), v_splat(low));
+    return v_fnmadd(a_low, v_splat(factor), top);
 }
 
 /* ---- encode ----------------------------------------------------------------------------- */
@@ -211,16 +224,13 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
  * Lanes it does not settle (none, by that bound) fail the exact checks and are redone.
  */
 
-/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w, with the mirrored
- * root's argument apex^2 + 3 - 12w as root_argument takes it, half a row low, floored and
+/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
+ * root's argument apex^2 + 3 - 12(w + 7/8) from wide_argument), half a row low, floored and
  * clamped to the rows. */
 SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, ivec w)
 {
-    ivec exact = i_sub(i_splat(c->mirrored), i_add(i_sll(w, 3), i_sll(w, 2)));
-    vec mirrored = c->rounded_rows
-                       ? root_argument(exact, v_fnmadd(v_from_i_rounded(w), v_splat(12.0), v_splat(c->mirrored_d)))
-                       : v_from_i_rounded(exact);
-    vec root = v_sqrt(v_max(v_sub(mirrored, v_splat(10.5)), v_zero()));
+    vec mirrored = wide_argument(c->mirrored_high, c->mirrored_low, 12.0, w);
+    vec root = v_sqrt(v_max(mirrored, v_zero()));
     return clamp_floor(v_fmsub(v_sub(v_splat(c->apex), root), v_splat(1.0 / 3.0), v_splat(0.5)), v_splat(c->last_row));
 }
 
@@ -241,8 +251,7 @@ SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, ivec w, vec est
 /* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
 SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, ivec code)
 {
-    ivec exact = i_sub(i_splat(c->root_argument), i_add(i_sll(code, 7), i_sll(code, 4)));
-    return root_argument(exact, v_fnmadd(v_from_i_rounded(code), v_splat(144.0), v_splat(c->root_argument_d)));
+    return wide_argument(c->root_high, c->root_low, 144.0, code);
 }
 
 /* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate), half a layer low, from its
