@@ -38,6 +38,7 @@ SP_INLINE SIMD_FN imask i_lt(ivec a, ivec b)
     ivec flip = i_splat((uint64_t)1 << 63);
     return _mm256_cmpgt_epi64(_mm256_xor_si256(b, flip), _mm256_xor_si256(a, flip));
 }
+SP_INLINE SIMD_FN imask i_lt_small(ivec a, ivec b) { return _mm256_cmpgt_epi64(b, a); }
 SP_INLINE SIMD_FN ivec i_select(imask m, ivec a, ivec b) { return _mm256_blendv_epi8(b, a, m); }
 SP_INLINE SIMD_FN unsigned im_bits(imask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
 

@@ -30,6 +30,7 @@ SP_INLINE SIMD_FN ivec i_mul32(ivec a, ivec b) { return _mm512_mul_epu32(a, b); 
 SP_INLINE SIMD_FN ivec i_mul(ivec a, ivec b) { return _mm512_mullo_epi64(a, b); }
 SP_INLINE SIMD_FN ivec i_mul_u32(ivec a, ivec b) { return i_mul(a, b); }
 SP_INLINE SIMD_FN imask i_lt(ivec a, ivec b) { return _mm512_cmplt_epu64_mask(a, b); }
+SP_INLINE SIMD_FN imask i_lt_small(ivec a, ivec b) { return _mm512_cmplt_epi64_mask(a, b); }
 SP_INLINE SIMD_FN ivec i_select(imask m, ivec a, ivec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned im_bits(imask m) { return m; }
 SP_INLINE SIMD_FN vec v_from_i(ivec a) { return _mm512_cvtepu64_pd(a); }

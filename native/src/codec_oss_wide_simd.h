@@ -24,7 +24,7 @@
  *   i_splat i_load i_store i_add i_sub i_and, i_srl(a, n) i_sll(a, n) (immediates), i_srlv
  *   i_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
  *   i_mul_u32(a, b)    a b mod 2^64 for b < 2^32; i_mul(a, b): a b mod 2^64
- *   i_lt (unsigned compare), i_select(m, a, b) = m ? a : b, im_bits (lanes as bits)
+ *   i_lt (unsigned compare), i_lt_small (both below 2^63), i_select(m, a, b) = m ? a : b, im_bits (lanes as bits)
  *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), i_from_v (integral doubles
  *   in [0, 2^52))
@@ -41,6 +41,7 @@ typedef struct wide_codec {
     uint64_t scale_bits;      /* 2(N - 1) */
     double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
     double apex, last_row, last_layer;
+    uint64_t rows;            /* (2N + 1) / 3 (K = 3) */
     uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
     uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
     double root_high, root_low;  /* 8M^3 + 12M^2 - 106 (M = N + 1) as two exact doubles (K = 4) */
@@ -64,6 +65,7 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     split_exactly(square, &c.mirrored_high, &c.mirrored_low);
     c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
     c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1), c.last_layer = (double)((n + 1) / 2 - 1);
+    c.rows = (2 * n + 1) / 3;
     c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
     sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
     sp_u128 root = sp_u128_sub(sp_u128_add(sp_u128_mul_u64(sp_u128_mul_u64(m2, m), 8), sp_u128_mul_u64(m2, 12)),
@@ -235,17 +237,18 @@ SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, ivec w)
 }
 
 /* K = 3: the row j of code w from its estimate (j or j - 1), and i = w - s_N(j), into q; returns
- * the lanes whose (j, i) is not proven right (i outside row j), as bits. The step up from the
- * last row never happens for a valid code (s_N(rows) is the code count). */
+ * the lanes whose (j, i) is not proven right (i outside row j, or j past the last row, whose
+ * length formula wraps: a step up from the last row, which only an estimate off by more than the
+ * bound takes), as bits. */
 SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, ivec w, vec estimate, vec* q)
 {
     ivec j = i_from_v(estimate), length = wide_row_length(c, j), i = i_sub(w, wide_row_base(c, j));
     imask above = i_lt(i_sub(length, i_splat(1)), i); /* i >= length: the next row */
     j = i_select(above, i_add(j, i_splat(1)), j);
     i = i_select(above, i_sub(i, length), i);
-    imask ok = i_lt(i, wide_row_length(c, j)); /* also false for a negative i, which wraps */
+    unsigned ok = im_bits(i_lt(i, wide_row_length(c, j))) & im_bits(i_lt_small(j, i_splat(c->rows))); /* i < 0 wraps */
     unpacked_block(c->n, 3, v_zero(), v_from_i(j), v_from_i(i), q);
-    return ~im_bits(ok) & ((1u << BLOCK) - 1);
+    return ~ok & ((1u << BLOCK) - 1);
 }
 
 /* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
@@ -269,13 +272,13 @@ SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
 }
 
 /* K = 4: rest = code - u(k) for the estimated layer k (k or k - 1), one step up, in double
- * lanes: exact while rest < 2^52, which *in_range reports (other lanes are redone). The row
+ * lanes: exact below 2^52, and a rest past that (a layer estimate off by more than the bound, or
+ * a negative rest, which wraps) stays past every layer's codes, rounded as it may be. The row
  * check then proves the layer: it accepts only a rest inside the layer's triangle. */
-SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, ivec code, vec* layer, unsigned* in_range)
+SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, ivec code, vec* layer)
 {
-    ivec offset = i_sub(code, wide_layer_base(c, i_from_v(*layer)));
-    *in_range = im_bits(i_lt(offset, i_splat((uint64_t)1 << 52)));
-    vec rest = v_from_i(offset), length = wide_layer_length(c->n, *layer);
+    vec rest = v_from_i_rounded(i_sub(code, wide_layer_base(c, i_from_v(*layer))));
+    vec length = wide_layer_length(c->n, *layer);
     mask above = m_ge(rest, length);
     *layer = v_add_where(*layer, above, v_splat(1.0));
     return v_sub(rest, v_add_where(v_zero(), above, length));
@@ -290,7 +293,7 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
     double inverse = 1.0 / (double)codec->scale;
     vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
     root z[DECODE_CHUNK];
-    unsigned missed[DECODE_CHUNK], in_range[DECODE_CHUNK]; /* lanes as bits */
+    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = wide_layer_argument(c, i_load(codes + b * BLOCK));
@@ -298,7 +301,7 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
         }
         for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
         for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_settle_layer(c, i_load(codes + b * BLOCK), &layer[b], &in_range[b]);
+            rest[b] = wide_settle_layer(c, i_load(codes + b * BLOCK), &layer[b]);
             bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
         }
         for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */
@@ -318,7 +321,7 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
             mask ok;
             vec i = row_offset(bottom[b], row[b], rest[b], &ok);
             unpacked_block(c->n, 4, layer[b], row[b], i, q);
-            missed[b] = ~(m_bits(ok) & in_range[b]) & ((1u << BLOCK) - 1);
+            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
         }
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
