@@ -197,6 +197,23 @@ static void path_coverage(const sp_codec* c, int encodes)
     CHECK(sp_oss_batch_supported(c) == encodes);
 }
 
+/* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero, not
+ * summing to 1): the vector lanes must hand them to the scalar code. */
+static void odd_weights(const sp_codec* c)
+{
+    static const float odd[] = {-1e-3f, -0.0f, 0.0f, NAN, INFINITY, -INFINITY, 0.5f, 2.0f, 1.0f, 0.75f};
+    uint32_t k = c->influences;
+    size_t count = 4000;
+    float* w = malloc(count * k * sizeof(float));
+    for (size_t v = 0; v < count; ++v) {
+        random_weights(k, w + v * k);
+        for (uint32_t i = 0; i < k; ++i)
+            if (rng_next() % 4 == 0) w[v * k + i] = odd[rng_next() % (sizeof(odd) / sizeof(odd[0]))];
+    }
+    compare_encode(c, w, count, "odd encode");
+    free(w);
+}
+
 /* Counts around the block sizes (chunks, blocks of 8 and 4, tails) and pointers off the
  * vectors' alignment; a zero count with null pointers is fine. */
 static void counts_and_alignment(const sp_codec* c)
@@ -218,6 +235,7 @@ static void counts_and_alignment(const sp_codec* c)
 static void check_codec(const sp_codec* c, int encodes)
 {
     counts_and_alignment(c);
+    odd_weights(c);
     path_coverage(c, encodes);
     boundaries(c);
     random_round_trips(c);
