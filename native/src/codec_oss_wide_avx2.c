@@ -73,5 +73,15 @@ SP_INLINE SIMD_FN vec v_from_i_rounded(ivec a)
     return v_add(v_sub(_mm256_castsi256_pd(high), v_splat(0x1p84 + 0x1p52)), _mm256_castsi256_pd(low));
 }
 
+/* K = 2 weights, as sp_grid_to_weights rounds them, stored as four vertices by one interleave
+ * (codec_oss_simd.h's store goes through memory for K < 4, slower here than the scalar loop). */
+SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)
+{
+    (void)layout;
+    __m128 first = _mm256_cvtpd_ps(v_mul(q0, v_splat(inverse))), second = _mm256_cvtpd_ps(v_mul(q1, v_splat(inverse)));
+    _mm_storeu_ps(out, _mm_unpacklo_ps(first, second));
+    _mm_storeu_ps(out + 4, _mm_unpackhi_ps(first, second));
+}
+
 #include "codec_oss_wide_simd.h"
 #endif

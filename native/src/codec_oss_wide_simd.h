@@ -28,6 +28,7 @@
  *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), i_from_v (integral doubles
  *   in [0, 2^52))
+ *   store_pairs(q0, q1, inverse, layout, out): store_weights for K = 2
  *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
  * and WIDE_NAME(name), the entry points' names.
  */
@@ -312,10 +313,12 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
         vec q[SP_MAX_INFLUENCES];
         ivec code = i_load(codes + b * BLOCK);
         missed[b] = 0;
-        if (k == 2) {
-            q[1] = v_from_i_rounded(code);
-            q[0] = v_from_i_rounded(i_sub(i_splat(c->scale_bits), code));
-        } else if (k == 3) {
+        if (k == 2) { /* the weights' own store: no q vector to build */
+            store_pairs(v_from_i_rounded(i_sub(i_splat(c->scale_bits), code)), v_from_i_rounded(code), inverse, layout,
+                        weights + b * BLOCK * 2);
+            continue;
+        }
+        if (k == 3) {
             missed[b] = wide_unpack_rows(c, code, row[b], q);
         } else {
             mask ok;
