@@ -74,13 +74,30 @@ SP_INLINE SIMD_FN vec v_from_i_rounded(ivec a)
 }
 
 /* K = 2 weights, as sp_grid_to_weights rounds them, stored as four vertices by one interleave
- * (codec_oss_simd.h's store goes through memory for K < 4, slower here than the scalar loop). */
+ * (codec_oss_simd.h's store goes through memory for K < 4: for K = 2 slower than the scalar
+ * loop). */
 SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)
 {
     (void)layout;
     __m128 first = _mm256_cvtpd_ps(v_mul(q0, v_splat(inverse))), second = _mm256_cvtpd_ps(v_mul(q1, v_splat(inverse)));
     _mm_storeu_ps(out, _mm_unpacklo_ps(first, second));
     _mm_storeu_ps(out + 4, _mm_unpackhi_ps(first, second));
+}
+
+/* K = 3 weights likewise, as four vertices: components 0, 1 through one permute, 2 through
+ * another, blended; then the last vertex and a half the same way. */
+SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_layout* layout, float* out)
+{
+    (void)layout;
+    __m128 w0 = _mm256_cvtpd_ps(v_mul(q[0], v_splat(inverse))), w1 = _mm256_cvtpd_ps(v_mul(q[1], v_splat(inverse)));
+    __m128 w2 = _mm256_cvtpd_ps(v_mul(q[2], v_splat(inverse)));
+    __m256 pairs = _mm256_insertf128_ps(_mm256_castps128_ps256(w0), w1, 1), thirds = _mm256_castps128_ps256(w2);
+    __m256 head = _mm256_blend_ps(_mm256_permutevar8x32_ps(pairs, _mm256_setr_epi32(0, 4, 0, 1, 5, 0, 2, 6)),
+                                  _mm256_permutevar8x32_ps(thirds, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 0, 0)), 0x24);
+    __m256 tail = _mm256_blend_ps(_mm256_permutevar8x32_ps(pairs, _mm256_setr_epi32(0, 3, 7, 0, 0, 0, 0, 0)),
+                                  _mm256_permutevar8x32_ps(thirds, _mm256_setr_epi32(2, 0, 0, 3, 0, 0, 0, 0)), 0x09);
+    _mm256_storeu_ps(out, head);
+    _mm_storeu_ps(out + 8, _mm256_castps256_ps128(tail));
 }
 
 #include "codec_oss_wide_simd.h"

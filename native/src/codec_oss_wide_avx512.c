@@ -42,11 +42,16 @@ SP_INLINE SIMD_FN void v_halves(ivec a, vec* high, vec* low)
 }
 SP_INLINE SIMD_FN ivec i_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
 
-/* K = 2 weights: codec_oss_simd.h's store (one two-source permute) serves. */
+/* K = 2 and 3 weights: codec_oss_simd.h's store (two-source permutes) serves. */
 SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)
 {
     vec q[2] = {q0, q1};
     store_weights(q, 2, inverse, layout, out);
+}
+
+SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_layout* layout, float* out)
+{
+    store_weights(q, 3, inverse, layout, out);
 }
 
 #include "codec_oss_wide_simd.h"

@@ -28,7 +28,8 @@
  *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), i_from_v (integral doubles
  *   in [0, 2^52))
- *   store_pairs(q0, q1, inverse, layout, out): store_weights for K = 2
+ *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
+ *                      store_weights for K = 2 and 3
  *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
  * and WIDE_NAME(name), the entry points' names.
  */
@@ -320,6 +321,8 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
         }
         if (k == 3) {
             missed[b] = wide_unpack_rows(c, code, row[b], q);
+            store_triples(q, inverse, layout, weights + b * BLOCK * 3);
+            continue;
         } else {
             mask ok;
             vec i = row_offset(bottom[b], row[b], rest[b], &ok);
