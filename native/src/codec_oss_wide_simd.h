@@ -37,10 +37,10 @@
 /* 9 u mod 2^64 -> u: 9 * INVERSE_OF_9 = 1 mod 2^64. */
 #define INVERSE_OF_9 0x8E38E38E38E38E39ull
 
-/* The per-codec constants of the wide lanes (mod 2^64 where marked; doubles rounded). */
+/* The per-codec constants of the wide lanes (mod 2^64 where marked). */
 typedef struct wide_codec {
-    double n, scale;          /* N and the grid 2(N - 1) */
-    uint64_t scale_bits;      /* 2(N - 1) */
+    double n, scale;          /* N and the grid 2(N - 1), rounded for K = 2 */
+    uint64_t n_bits, scale_bits;
     double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
     double apex, last_row, last_layer;
     uint64_t rows;            /* (2N + 1) / 3 (K = 3) */
@@ -62,7 +62,7 @@ static wide_codec wide_codec_for(const sp_codec* codec)
 {
     uint64_t n = codec->n, m = n + 1, apex = 2 * n + 1; /* wraps for K = 2 past 2^63: unused there */
     wide_codec c;
-    c.n = (double)n, c.scale = (double)codec->scale, c.scale_bits = codec->scale;
+    c.n = (double)n, c.scale = (double)codec->scale, c.n_bits = n, c.scale_bits = codec->scale;
     sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(apex), sp_u128_from(apex)), 3);
     split_exactly(square, &c.mirrored_high, &c.mirrored_low);
     c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
@@ -91,13 +91,13 @@ static wide_codec wide_codec_for(const sp_codec* codec)
 SP_INLINE SIMD_FN ivec wide_row_base(const wide_codec* c, ivec j)
 {
     ivec one = i_splat(1), half = i_srl(i_add(j, one), 1), half_up = i_srl(i_add(j, i_splat(2)), 1);
-    return i_add(i_mul(j, i_sub(i_splat((uint64_t)c->n), j)), i_mul32(half, half_up));
+    return i_add(i_mul(j, i_sub(i_splat(c->n_bits), j)), i_mul32(half, half_up));
 }
 
 /* Codes in row j, floor((2N - 3j) / 2) = N - j - (j + 1) / 2 (at least 1 for rows j < rows). */
 SP_INLINE SIMD_FN ivec wide_row_length(const wide_codec* c, ivec j)
 {
-    return i_sub(i_sub(i_splat((uint64_t)c->n), j), i_srl(i_add(j, i_splat(1)), 1));
+    return i_sub(i_sub(i_splat(c->n_bits), j), i_srl(i_add(j, i_splat(1)), 1));
 }
 
 /* u(k) = floor(a / 9), a = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 (Horner, mod 2^64), for layers
@@ -223,9 +223,11 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
 
 /*
  * The estimates here are taken half a row or layer low: the rounded roots are off by far less
- * than half a step (below 1e-4 of a row for K = 3, ~0.04 of a layer for the AVX2 cube root), so
- * floored, an estimate is the step or the one before it, and one compare going up settles it.
- * Lanes it does not settle (none, by that bound) fail the exact checks and are redone.
+ * than half a step (K = 3: ~1e-5 of a row, from the argument's and the square root's rounding at
+ * 2^-52 of values up to 2^34; K = 4: AVX-512's root and AVX2's after its Newton step, no lane of
+ * the tests' tens of millions missed), so floored, an estimate is the step or the one before it,
+ * and one compare going up settles it. Lanes it does not settle fail the exact checks, whatever
+ * the estimate was (checked with estimates biased by two steps and more), and are redone.
  */
 
 /* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
@@ -313,23 +315,20 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
     for (size_t b = 0; b < blocks; ++b) {
         vec q[SP_MAX_INFLUENCES];
         ivec code = i_load(codes + b * BLOCK);
+        float* out = weights + b * BLOCK * k;
         missed[b] = 0;
-        if (k == 2) { /* the weights' own store: no q vector to build */
-            store_pairs(v_from_i_rounded(i_sub(i_splat(c->scale_bits), code)), v_from_i_rounded(code), inverse, layout,
-                        weights + b * BLOCK * 2);
-            continue;
-        }
-        if (k == 3) {
+        if (k == 2) { /* no grid vectors to build */
+            store_pairs(v_from_i_rounded(i_sub(i_splat(c->scale_bits), code)), v_from_i_rounded(code), inverse, layout, out);
+        } else if (k == 3) {
             missed[b] = wide_unpack_rows(c, code, row[b], q);
-            store_triples(q, inverse, layout, weights + b * BLOCK * 3);
-            continue;
+            store_triples(q, inverse, layout, out);
         } else {
             mask ok;
             vec i = row_offset(bottom[b], row[b], rest[b], &ok);
             unpacked_block(c->n, 4, layer[b], row[b], i, q);
             missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
+            store_weights(q, 4, inverse, layout, out);
         }
-        store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
     for (size_t b = 0; b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
