@@ -2,9 +2,10 @@
  * The wide OSS vector paths (codec_oss_wide_simd.h: 64-bit integer lanes for K = 3 past
  * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 decode past N = 2^48) against the scalar code, bit
  * for bit, once per vector path the CPU has: codes around every layer start (K = 4) and around
- * row starts (every row of sampled layers, and the first, last and sampled rows for K = 3, where
- * the root arguments switch from exact to rounded), the last codes, random codes and weights
- * from 46 to 64 bits, and invalid codes, which stop the batch where the scalar code stops.
+ * row starts (every row of sampled layers; for K = 3 every row just past the double lanes, and
+ * the first, last and sampled rows of wider codes, where the root arguments stop being exact),
+ * the last codes, random codes and weights from 46 to 64 bits, odd weights, counts and
+ * alignments, and invalid codes, which stop the batch where the scalar code stops.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -118,6 +119,20 @@ static void boundaries(const sp_codec* c)
     }
     for (uint64_t d = 0; d < 64; ++d) codes[count++] = c->max_code - d;
     compare_decode(c, codes, count, "boundary decode");
+    free(codes);
+}
+
+/* K = 3 just past the double lanes (N = 2^24 + 1): codes around every row start, in batches. */
+static void every_row_start(void)
+{
+    sp_codec c = oss_n(3, ((uint64_t)1 << 24) + 1);
+    uint64_t rows = (2 * c.n + 1) / 3, batch = 1 << 18;
+    uint64_t* codes = malloc(batch * 4 * sizeof(uint64_t));
+    for (uint64_t first = 0; first <= rows; first += batch) {
+        size_t count = 0;
+        for (uint64_t j = first; j < first + batch && j <= rows; ++j) count = push_around(&c, sp_oss_row_base(c.n, j), codes, count);
+        compare_decode(&c, codes, count, "row start decode");
+    }
     free(codes);
 }
 
@@ -261,6 +276,7 @@ int main(void)
         check_codec(&k2_52, 0); /* K = 2 encode past 2^49 rounds in long double: scalar */
         check_codec(&k2_64, 0);
         check_codec(&k2_past, 0);
+        every_row_start();
     }
     return check_report("test_batch_wide");
 }
