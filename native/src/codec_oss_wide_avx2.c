@@ -14,42 +14,42 @@
 
 #define WIDE_ROOT_NEWTON 1 /* its cube root is ~4e-8 off in places */
 
-typedef __m256i ivec;
-typedef __m256i imask; /* all-ones lanes */
+typedef __m256i uvec;
+typedef __m256i umask; /* all-ones lanes */
 
-#define i_srl(a, n) _mm256_srli_epi64(a, n)
-#define i_sll(a, n) _mm256_slli_epi64(a, n)
-SP_INLINE SIMD_FN ivec i_splat(uint64_t x) { return _mm256_set1_epi64x((int64_t)x); }
-SP_INLINE SIMD_FN ivec i_load(const uint64_t* p) { return _mm256_loadu_si256((const __m256i*)p); }
-SP_INLINE SIMD_FN void i_store(uint64_t* p, ivec a) { _mm256_storeu_si256((__m256i*)p, a); }
-SP_INLINE SIMD_FN ivec i_add(ivec a, ivec b) { return _mm256_add_epi64(a, b); }
-SP_INLINE SIMD_FN ivec i_sub(ivec a, ivec b) { return _mm256_sub_epi64(a, b); }
-SP_INLINE SIMD_FN ivec i_and(ivec a, ivec b) { return _mm256_and_si256(a, b); }
-SP_INLINE SIMD_FN ivec i_srlv(ivec a, ivec count) { return _mm256_srlv_epi64(a, count); }
-SP_INLINE SIMD_FN ivec i_mul32(ivec a, ivec b) { return _mm256_mul_epu32(a, b); }
-SP_INLINE SIMD_FN ivec i_mul_u32(ivec a, ivec b) { return i_add(i_mul32(a, b), i_sll(i_mul32(i_srl(a, 32), b), 32)); }
-SP_INLINE SIMD_FN ivec i_mul(ivec a, ivec b)
+#define u_srl(a, n) _mm256_srli_epi64(a, n)
+#define u_sll(a, n) _mm256_slli_epi64(a, n)
+SP_INLINE SIMD_FN uvec u_splat(uint64_t x) { return _mm256_set1_epi64x((int64_t)x); }
+SP_INLINE SIMD_FN uvec u_load(const uint64_t* p) { return _mm256_loadu_si256((const __m256i*)p); }
+SP_INLINE SIMD_FN void u_store(uint64_t* p, uvec a) { _mm256_storeu_si256((__m256i*)p, a); }
+SP_INLINE SIMD_FN uvec u_add(uvec a, uvec b) { return _mm256_add_epi64(a, b); }
+SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm256_sub_epi64(a, b); }
+SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm256_and_si256(a, b); }
+SP_INLINE SIMD_FN uvec u_srlv(uvec a, uvec count) { return _mm256_srlv_epi64(a, count); }
+SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm256_mul_epu32(a, b); }
+SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_add(u_mul32(a, b), u_sll(u_mul32(u_srl(a, 32), b), 32)); }
+SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b)
 {
-    ivec cross = i_add(i_mul32(i_srl(a, 32), b), i_mul32(a, i_srl(b, 32)));
-    return i_add(i_mul32(a, b), i_sll(cross, 32));
+    uvec cross = u_add(u_mul32(u_srl(a, 32), b), u_mul32(a, u_srl(b, 32)));
+    return u_add(u_mul32(a, b), u_sll(cross, 32));
 }
-SP_INLINE SIMD_FN imask i_lt(ivec a, ivec b)
+SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b)
 {
-    ivec flip = i_splat((uint64_t)1 << 63);
+    uvec flip = u_splat((uint64_t)1 << 63);
     return _mm256_cmpgt_epi64(_mm256_xor_si256(b, flip), _mm256_xor_si256(a, flip));
 }
-SP_INLINE SIMD_FN imask i_lt_small(ivec a, ivec b) { return _mm256_cmpgt_epi64(b, a); }
-SP_INLINE SIMD_FN ivec i_select(imask m, ivec a, ivec b) { return _mm256_blendv_epi8(b, a, m); }
-SP_INLINE SIMD_FN unsigned im_bits(imask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
+SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return _mm256_cmpgt_epi64(b, a); }
+SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm256_blendv_epi8(b, a, m); }
+SP_INLINE SIMD_FN unsigned um_bits(umask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
 
 /* Below 2^52 through the mantissa of 2^52, both ways (garbage elsewhere, as load_codes). */
-SP_INLINE SIMD_FN vec v_from_i(ivec a)
+SP_INLINE SIMD_FN vec v_from_u(uvec a)
 {
     vec magic = v_splat(0x1p52);
     return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(a, _mm256_castpd_si256(magic))), magic);
 }
 
-SP_INLINE SIMD_FN ivec i_from_v(vec x)
+SP_INLINE SIMD_FN uvec u_from_v(vec x)
 {
     vec magic = v_splat(0x1p52);
     return _mm256_xor_si256(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic));
@@ -57,19 +57,19 @@ SP_INLINE SIMD_FN ivec i_from_v(vec x)
 
 /* The two 32-bit halves: the low one in the mantissa of 2^52 (no masking: the blend puts 2^52's
  * high half over it). */
-SP_INLINE SIMD_FN void v_halves(ivec a, vec* high, vec* low)
+SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
 {
     vec magic = v_splat(0x1p52);
-    *high = v_from_i(i_srl(a, 32));
+    *high = v_from_u(u_srl(a, 32));
     *low = v_sub(_mm256_castsi256_pd(_mm256_blend_epi32(a, _mm256_castpd_si256(magic), 0xAA)), magic);
 }
 
 /* Any u64, rounded to nearest: 2^84 + 2^32 hi and 2^52 + lo are exact doubles, so is
  * 2^32 hi - 2^52 (a multiple of 2^32 below 2^64), and the one rounding is the final sum's. */
-SP_INLINE SIMD_FN vec v_from_i_rounded(ivec a)
+SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a)
 {
-    ivec high = _mm256_or_si256(i_srl(a, 32), _mm256_castpd_si256(v_splat(0x1p84)));
-    ivec low = _mm256_blend_epi32(a, _mm256_castpd_si256(v_splat(0x1p52)), 0xAA);
+    uvec high = _mm256_or_si256(u_srl(a, 32), _mm256_castpd_si256(v_splat(0x1p84)));
+    uvec low = _mm256_blend_epi32(a, _mm256_castpd_si256(v_splat(0x1p52)), 0xAA);
     return v_add(v_sub(_mm256_castsi256_pd(high), v_splat(0x1p84 + 0x1p52)), _mm256_castsi256_pd(low));
 }
 

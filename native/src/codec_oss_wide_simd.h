@@ -20,13 +20,13 @@
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN), on top of the
  * double-lane primitives of codec_oss_simd.h:
- *   ivec, imask        BLOCK unsigned 64-bit lanes and a lane mask
- *   i_splat i_load i_store i_add i_sub i_and, i_srl(a, n) i_sll(a, n) (immediates), i_srlv
- *   i_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
- *   i_mul_u32(a, b)    a b mod 2^64 for b < 2^32; i_mul(a, b): a b mod 2^64
- *   i_lt (unsigned compare), i_lt_small (both below 2^63), i_select(m, a, b) = m ? a : b, im_bits (lanes as bits)
- *   v_from_i (exact below 2^52), v_from_i_rounded (any, rounded to nearest as C converts),
- *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), i_from_v (integral doubles
+ *   uvec, umask        BLOCK unsigned 64-bit lanes and a lane mask
+ *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates), u_srlv
+ *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
+ *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
+ *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_select(m, a, b) = m ? a : b, um_bits (lanes as bits)
+ *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
+ *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
  *   in [0, 2^52))
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
@@ -88,29 +88,29 @@ static wide_codec wide_codec_for(const sp_codec* codec)
  * s_N(j) = j (N - j) + floor((j + 1)^2 / 4) = j (N - j) + floor((j + 1) / 2) ceil((j + 1) / 2),
  * below 2^64 inside the triangle: a product mod 2^64 (no floor of a wrapped value) and one of
  * two halves below 2^32. */
-SP_INLINE SIMD_FN ivec wide_row_base(const wide_codec* c, ivec j)
+SP_INLINE SIMD_FN uvec wide_row_base(const wide_codec* c, uvec j)
 {
-    ivec one = i_splat(1), half = i_srl(i_add(j, one), 1), half_up = i_srl(i_add(j, i_splat(2)), 1);
-    return i_add(i_mul(j, i_sub(i_splat(c->n_bits), j)), i_mul32(half, half_up));
+    uvec one = u_splat(1), half = u_srl(u_add(j, one), 1), half_up = u_srl(u_add(j, u_splat(2)), 1);
+    return u_add(u_mul(j, u_sub(u_splat(c->n_bits), j)), u_mul32(half, half_up));
 }
 
 /* Codes in row j, floor((2N - 3j) / 2) = N - j - (j + 1) / 2 (at least 1 for rows j < rows). */
-SP_INLINE SIMD_FN ivec wide_row_length(const wide_codec* c, ivec j)
+SP_INLINE SIMD_FN uvec wide_row_length(const wide_codec* c, uvec j)
 {
-    return i_sub(i_sub(i_splat(c->n_bits), j), i_srl(i_add(j, i_splat(1)), 1));
+    return u_sub(u_sub(u_splat(c->n_bits), j), u_srl(u_add(j, u_splat(1)), 1));
 }
 
 /* u(k) = floor(a / 9), a = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 (Horner, mod 2^64), for layers
  * k < 2^32: (a - a mod 9) times 9's inverse. k mod 3 from floor(k / 3) = k 0xAAAAAAAB / 2^33. */
-SP_INLINE SIMD_FN ivec wide_layer_base(const wide_codec* c, ivec k)
+SP_INLINE SIMD_FN uvec wide_layer_base(const wide_codec* c, uvec k)
 {
-    ivec third = i_srl(i_mul32(k, i_splat(0xAAAAAAABu)), 33);
-    ivec k_mod3 = i_sub(k, i_add(third, i_add(third, third)));
-    ivec r = i_and(i_srlv(i_splat(c->layer_remainders), i_sll(k_mod3, 2)), i_splat(15));
-    ivec a = i_sub(i_sll(k, 2), i_splat(c->layer_c1));
-    a = i_add(i_mul_u32(a, k), i_splat(c->layer_c0));
-    a = i_add(i_mul_u32(a, k), i_splat(2));
-    return i_mul(i_sub(a, r), i_splat(INVERSE_OF_9));
+    uvec third = u_srl(u_mul32(k, u_splat(0xAAAAAAABu)), 33);
+    uvec k_mod3 = u_sub(k, u_add(third, u_add(third, third)));
+    uvec r = u_and(u_srlv(u_splat(c->layer_remainders), u_sll(k_mod3, 2)), u_splat(15));
+    uvec a = u_sub(u_sll(k, 2), u_splat(c->layer_c1));
+    a = u_add(u_mul_u32(a, k), u_splat(c->layer_c0));
+    a = u_add(u_mul_u32(a, k), u_splat(2));
+    return u_mul(u_sub(a, r), u_splat(INVERSE_OF_9));
 }
 
 /* Codes in layer k, u(k + 1) - u(k) = (b^2 + b + 1) / 3 with b = N - 2k < 2^23, as
@@ -126,7 +126,7 @@ SP_INLINE SIMD_FN vec wide_layer_length(double n, vec k)
  * with a = 2^32 ah + al, high - (factor 2^32) ah is exact (a multiple of 2^20 below 2^73), the
  * rest rounds only where the sum is past 2^53. So exact for small results, where the roots'
  * arguments cancel, and within 2^-52 of it otherwise. */
-SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, ivec a)
+SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec a)
 {
     vec a_high, a_low;
     v_halves(a, &a_high, &a_low);
@@ -138,25 +138,25 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, ivec
 
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
  * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h. */
-SP_INLINE SIMD_FN ivec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
+SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
-    if (k == 2) return i_from_v(q[1]);
-    if (k == 3) return i_add(wide_row_base(c, i_from_v(q[2])), i_from_v(v_sub(q[1], q[2])));
+    if (k == 2) return u_from_v(q[1]);
+    if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
     vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n));
     vec in_layer = v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2]));
-    return i_add(wide_layer_base(c, i_from_v(q[3])), i_from_v(in_layer));
+    return u_add(wide_layer_base(c, u_from_v(q[3])), u_from_v(in_layer));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
  * as bits (the grids here are below 2^50, where sp_grid_quantize rounds in double, so
  * codec_oss_simd.h's rounding is exact). */
-SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, uint32_t k, uint64_t* codes,
-                                             uint8_t* significant)
+SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, unsigned ordered, uint32_t k,
+                                             uint64_t* codes, uint8_t* significant)
 {
     vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
     vec deficit = quantize_floor(w, k, c->scale, scale, q, remainder);
-    unsigned missed = round_block(k, deficit, remainder, q);
-    i_store(codes, wide_pack(c, q, k));
+    unsigned missed = round_block(k, deficit, remainder, q, ordered);
+    u_store(codes, wide_pack(c, q, k));
     if (significant) store_significant(q, k, significant);
     return missed;
 }
@@ -169,23 +169,24 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec
                                          const simd_layout* layout)
 {
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
-    unsigned missed[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, c->scale);
+        ordered[b] = weights_ordered(w[b], k);
     }
     if (ENCODE_FUSED)
         for (size_t b = 0; b < blocks; ++b)
-            missed[b] = wide_encode_block(c, w[b], scale[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+            missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     else {
         vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
         vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
         for (size_t b = 0; b < blocks; ++b) {
             deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
         }
         for (size_t b = 0; b < blocks; ++b) {
-            i_store(codes + b * BLOCK, wide_pack(c, q[b], k));
+            u_store(codes + b * BLOCK, wide_pack(c, q[b], k));
             if (significant) store_significant(q[b], k, significant + b * BLOCK);
         }
     }
@@ -233,7 +234,7 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
 /* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
  * root's argument apex^2 + 3 - 12(w + 7/8) from wide_argument), half a row low, floored and
  * clamped to the rows. */
-SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, ivec w)
+SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, uvec w)
 {
     vec mirrored = wide_argument(c->mirrored_high, c->mirrored_low, 12.0, w);
     vec root = v_sqrt(v_max(mirrored, v_zero()));
@@ -244,19 +245,19 @@ SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, ivec w)
  * the lanes whose (j, i) is not proven right (i outside row j, or j past the last row, whose
  * length formula wraps: a step up from the last row, which only an estimate off by more than the
  * bound takes), as bits. */
-SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, ivec w, vec estimate, vec* q)
+SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, uvec w, vec estimate, vec* q)
 {
-    ivec j = i_from_v(estimate), length = wide_row_length(c, j), i = i_sub(w, wide_row_base(c, j));
-    imask above = i_lt(i_sub(length, i_splat(1)), i); /* i >= length: the next row */
-    j = i_select(above, i_add(j, i_splat(1)), j);
-    i = i_select(above, i_sub(i, length), i);
-    unsigned ok = im_bits(i_lt(i, wide_row_length(c, j))) & im_bits(i_lt_small(j, i_splat(c->rows))); /* i < 0 wraps */
-    unpacked_block(c->n, 3, v_zero(), v_from_i(j), v_from_i(i), q);
+    uvec j = u_from_v(estimate), length = wide_row_length(c, j), i = u_sub(w, wide_row_base(c, j));
+    umask above = u_lt(u_sub(length, u_splat(1)), i); /* i >= length: the next row */
+    j = u_select(above, u_add(j, u_splat(1)), j);
+    i = u_select(above, u_sub(i, length), i);
+    unsigned ok = um_bits(u_lt(i, wide_row_length(c, j))) & um_bits(u_lt_small(j, u_splat(c->rows))); /* i < 0 wraps */
+    unpacked_block(c->n, 3, v_zero(), v_from_u(j), v_from_u(i), q);
     return ~ok & ((1u << BLOCK) - 1);
 }
 
 /* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
-SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, ivec code)
+SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, uvec code)
 {
     return wide_argument(c->root_high, c->root_low, 144.0, code);
 }
@@ -279,9 +280,9 @@ SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
  * lanes: exact below 2^52, and a rest past that (a layer estimate off by more than the bound, or
  * a negative rest, which wraps) stays past every layer's codes, rounded as it may be. The row
  * check then proves the layer: it accepts only a rest inside the layer's triangle. */
-SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, ivec code, vec* layer)
+SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, uvec code, vec* layer)
 {
-    vec rest = v_from_i_rounded(i_sub(code, wide_layer_base(c, i_from_v(*layer))));
+    vec rest = v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(*layer))));
     vec length = wide_layer_length(c->n, *layer);
     mask above = m_ge(rest, length);
     *layer = v_add_where(*layer, above, v_splat(1.0));
@@ -300,25 +301,25 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
     unsigned missed[DECODE_CHUNK]; /* lanes as bits */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
-            x[b] = wide_layer_argument(c, i_load(codes + b * BLOCK));
+            x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
             z[b] = root_start(x[b]);
         }
         for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
         for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_settle_layer(c, i_load(codes + b * BLOCK), &layer[b]);
+            rest[b] = wide_settle_layer(c, u_load(codes + b * BLOCK), &layer[b]);
             bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
         }
         for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */
     }
     if (k == 3)
-        for (size_t b = 0; b < blocks; ++b) row[b] = wide_row_estimate(c, i_load(codes + b * BLOCK));
+        for (size_t b = 0; b < blocks; ++b) row[b] = wide_row_estimate(c, u_load(codes + b * BLOCK));
     for (size_t b = 0; b < blocks; ++b) {
         vec q[SP_MAX_INFLUENCES];
-        ivec code = i_load(codes + b * BLOCK);
+        uvec code = u_load(codes + b * BLOCK);
         float* out = weights + b * BLOCK * k;
         missed[b] = 0;
         if (k == 2) { /* no grid vectors to build */
-            store_pairs(v_from_i_rounded(i_sub(i_splat(c->scale_bits), code)), v_from_i_rounded(code), inverse, layout, out);
+            store_pairs(v_from_u_rounded(u_sub(u_splat(c->scale_bits), code)), v_from_u_rounded(code), inverse, layout, out);
         } else if (k == 3) {
             missed[b] = wide_unpack_rows(c, code, row[b], q);
             store_triples(q, inverse, layout, out);
