@@ -2,6 +2,8 @@
 #ifndef SKINPACK_CODEC_INTERNAL_H
 #define SKINPACK_CODEC_INTERNAL_H
 
+#include <string.h> /* memcpy: sp_double_bits */
+
 #include "skinpack.h"
 
 #include "cpu_features.h"
@@ -28,43 +30,71 @@ SP_INLINE double sp_positive_or_zero(double x)
 #endif
 }
 
+/* Grids below this size take the double-precision rounding (sp_grid_round); larger ones the
+ * long double one of sp_grid_quantize_general. */
+#define SP_GRID_DOUBLE_LIMIT ((uint64_t)1 << 50)
+
+/* s / (the sum of the k weights), the grid scale of one vertex: its own step, so that a batch
+ * can run the divisions of several vertices before their roundings (the division ends a long
+ * chain). The sum starts at weights[0], not 0 + weights[0]: they differ only when every weight
+ * is -0, where the scale is -inf instead of +inf and every product 0 * inf is NaN either way. */
+SP_INLINE double sp_grid_scale(const float* weights, uint32_t k, double s)
+{
+    double sum = weights[0];
+    SP_UNROLL for (uint32_t i = 1; i < k; ++i) sum += weights[i];
+    return s / sum;
+}
+
+/* Bits of a double: for x >= +0 (never -0 or NaN) their order as integers is the order of x. */
+SP_INLINE uint64_t sp_double_bits(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof(bits));
+    return bits;
+}
+
 /*
- * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s.
- * Inlined so that callers with a constant k get unrolled, branch-free code: for grids below
- * 2^50 (double is exact enough) floor by conversion, then add one to the d largest remainders
- * chosen by rank instead of by sorting.
+ * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s,
+ * for grids s < SP_GRID_DOUBLE_LIMIT (double is exact enough) and scale = sp_grid_scale: floor
+ * by conversion, then add one to the d largest remainders chosen by rank instead of by sorting.
+ * Returns 0, q undefined, where the deficit d is not in [0, k) (degenerate input): the general
+ * rounding decides those. Inlined so that callers with a constant k get unrolled, branch-free
+ * code with q in registers.
  */
+SP_INLINE int sp_grid_round(const float* weights, uint32_t k, uint64_t s, double scale, uint64_t* q)
+{
+    k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES;
+    uint64_t remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, deficit = s; /* as bits: x - floor(x) >= +0 */
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
+        double x = weights[i] * scale;
+        x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
+        x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
+        int64_t f = (int64_t)x;
+        q[i] = (uint64_t)f;
+        remainder[i] = sp_double_bits(x - (double)f);
+        deficit -= (uint64_t)f; /* s < 2^50 and each f <= s: wraps only below zero */
+    }
+    if (deficit >= k) return 0;
+    /* rank[i]: components that win the bump before i (larger, or equal and lower); each pair
+     * is compared once, a < b wins when its remainder is not smaller. */
+    uint64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) rank[i] = k - 1 - i; /* every later slot, unless i wins */
+    SP_UNROLL for (uint32_t a = 0; a < k; ++a)
+        SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
+            uint64_t a_wins = remainder[a] >= remainder[b];
+            rank[b] += a_wins;
+            rank[a] -= a_wins;
+        }
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += rank[i] < deficit;
+    return 1;
+}
+
+/* Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s:
+ * sp_grid_round where it applies, else the general rounding. */
 SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
-    if (s < ((uint64_t)1 << 50)) {
-        double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, sum = 0;
-        SP_UNROLL for (uint32_t i = 0; i < k; ++i) sum += weights[i];
-        double scale = (double)s / sum;
-        int64_t deficit = (int64_t)s;
-        SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
-            double x = weights[i] * scale;
-            x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
-            x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
-            int64_t f = (int64_t)x;
-            q[i] = (uint64_t)f;
-            remainder[i] = x - (double)f;
-            deficit -= f;
-        }
-        if (deficit >= 0 && deficit < (int64_t)k) {
-            /* rank[i]: components that win the bump before i (larger, or equal and lower);
-             * each pair is compared once, a < b wins when its remainder is not smaller. */
-            int64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            SP_UNROLL for (uint32_t a = 0; a < k; ++a)
-                SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
-                    int64_t a_wins = remainder[a] >= remainder[b];
-                    rank[b] += a_wins;
-                    rank[a] += 1 - a_wins;
-                }
-            SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
-            return;
-        }
-    }
+    if (s < SP_GRID_DOUBLE_LIMIT && sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
     sp_grid_quantize_general(weights, k, s, q);
 }
 
