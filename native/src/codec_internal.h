@@ -2,8 +2,6 @@
 #ifndef SKINPACK_CODEC_INTERNAL_H
 #define SKINPACK_CODEC_INTERNAL_H
 
-#include <string.h> /* memcpy: sp_double_bits */
-
 #include "skinpack.h"
 
 #include "cpu_features.h"
@@ -45,14 +43,6 @@ SP_INLINE double sp_grid_scale(const float* weights, uint32_t k, double s)
     return s / sum;
 }
 
-/* Bits of a double: for x >= +0 (never -0 or NaN) their order as integers is the order of x. */
-SP_INLINE uint64_t sp_double_bits(double x)
-{
-    uint64_t bits;
-    memcpy(&bits, &x, sizeof(bits));
-    return bits;
-}
-
 /*
  * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s,
  * for grids s < SP_GRID_DOUBLE_LIMIT (double is exact enough) and scale = sp_grid_scale: floor
@@ -64,14 +54,15 @@ SP_INLINE uint64_t sp_double_bits(double x)
 SP_INLINE int sp_grid_round(const float* weights, uint32_t k, uint64_t s, double scale, uint64_t* q)
 {
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES;
-    uint64_t remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, deficit = s; /* as bits: x - floor(x) >= +0 */
+    double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    uint64_t deficit = s;
     SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
         double x = weights[i] * scale;
         x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
         x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
         int64_t f = (int64_t)x;
         q[i] = (uint64_t)f;
-        remainder[i] = sp_double_bits(x - (double)f);
+        remainder[i] = x - (double)f;
         deficit -= (uint64_t)f; /* s < 2^50 and each f <= s: wraps only below zero */
     }
     if (deficit >= k) return 0;

@@ -168,13 +168,12 @@ SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, si
         for (size_t c = 0; c < chunk; ++c) scale[c] = sp_grid_scale(weights + (v + c) * k, k, (double)s);
         for (size_t c = 0; c < chunk; ++c) {
             const float* vertex = weights + (v + c) * k;
-            uint8_t* count_out = significant ? significant + v + c : NULL;
             uint64_t q[SP_MAX_INFLUENCES];
             if (!sp_grid_round(vertex, k, s, scale[c], q)) {
-                codes[v + c] = sp_oss_encode_one(codec, vertex, count_out);
+                codes[v + c] = sp_oss_encode_one(codec, vertex, significant ? significant + v + c : NULL);
                 continue;
             }
-            if (count_out) *count_out = sp_grid_significant(q, k);
+            if (significant) significant[v + c] = sp_grid_significant(q, k);
             codes[v + c] = small ? oss_pack_small(&form, k, q) : oss_pack(n, k, q);
         }
     }
