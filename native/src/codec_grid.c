@@ -129,7 +129,7 @@ SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, ui
         }
 }
 
-/* quantize_general for k = 2, what OSS codes of 51..64 bits (grids past 2^50) take per vertex:
+/* quantize_general for k = 2, what odd input (not plain, see sp_grid_pair) takes:
  * the same floors, and for a deficit d (s - q0 - q1 >= 0) the same d/2 each and the odd one to
  * the larger remainder (ties to slot 0), as selects: d is 0 or 1 at random, which a branch
  * mispredicts. A sum past s (degenerate input) takes the general code. */
@@ -153,10 +153,31 @@ SP_INLINE void quantize_pair(const float* weights, uint64_t s, uint64_t* q)
     q[1] = q0 > q1 ? q1 : q0;
 }
 
+/* sp_grid_round_pair's exact rounding for plain pairs of any gap, in 128 bits: a gap past 66
+ * puts x below 1/4 (x < s small / (large 2^gap) < 2^64 2^24 / 2^(23 + gap), the larger weight
+ * being normal), else D < 2^91 and s small < 2^88, floor and remainder by division. Returns 0 for
+ * input that is not plain. */
+static int quantize_pair_exact(const float* weights, uint64_t s, uint64_t* q)
+{
+    sp_grid_pair pair = sp_grid_pair_parts(weights);
+    if (!pair.plain) return 0;
+    uint64_t nearest = 0;
+    if (pair.gap <= 66) {
+        sp_u128 sum = sp_u128_add_u64(sp_u128_mul_u64(sp_u128_pow2(pair.gap), pair.large), pair.small);
+        sp_u128 product = sp_u128_mul_u64(sp_u128_from(s), pair.small);
+        sp_u128 whole = sp_u128_div(product, sum), rest = sp_u128_sub(product, sp_u128_mul(whole, sum));
+        sp_u128 twice = sp_u128_add_u64(sp_u128_add(rest, rest), pair.ties_up);
+        nearest = sp_u128_low(whole) + (uint64_t)sp_u128_less(sum, twice);
+    }
+    q[0] = s - nearest;
+    q[1] = nearest;
+    return 1;
+}
+
 void sp_grid_quantize_general(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
-    if (k == 2) quantize_pair(weights, s, q);
-    else quantize_general(weights, k, s, q);
+    if (k != 2) quantize_general(weights, k, s, q);
+    else if (s < SP_GRID_DOUBLE_LIMIT || !quantize_pair_exact(weights, s, q)) quantize_pair(weights, s, q);
 }
 
 /* Stored components: Fixed stores q[0..k-1], Cube and POT q[1..k-1]. */

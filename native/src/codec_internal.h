@@ -2,6 +2,8 @@
 #ifndef SKINPACK_CODEC_INTERNAL_H
 #define SKINPACK_CODEC_INTERNAL_H
 
+#include <string.h> /* memcpy */
+
 #include "skinpack.h"
 
 #include "cpu_features.h"
@@ -80,12 +82,81 @@ SP_INLINE int sp_grid_round(const float* weights, uint32_t k, uint64_t s, double
     return 1;
 }
 
+/*
+ * The two weights of a K = 2 rounding as exact integers: the smaller one is small 2^e, the
+ * larger large 2^(e + gap), with 24-bit significands (a denormal's exponent is the smallest
+ * normal one's). The smaller is slot 1 where the two are equal; ties_up is 1 where it is slot 0
+ * (the tie rule gives a tie to slot 0, so that slot's x rounds half up, slot 1's half down).
+ * plain: both finite and >= 0 (-0 counts as 0) and not both zero; the rest is the general
+ * rounding's (odd input keeps its results).
+ */
+typedef struct sp_grid_pair {
+    uint64_t small, large;
+    uint32_t gap, ties_up, plain;
+} sp_grid_pair;
+
+SP_INLINE sp_grid_pair sp_grid_pair_parts(const float* weights)
+{
+    uint32_t bits0, bits1;
+    memcpy(&bits0, &weights[0], sizeof(bits0));
+    memcpy(&bits1, &weights[1], sizeof(bits1));
+    uint32_t magnitude0 = bits0 & 0x7FFFFFFFu, magnitude1 = bits1 & 0x7FFFFFFFu; /* the order of >= 0 floats */
+    sp_grid_pair pair;
+    pair.ties_up = magnitude0 < magnitude1;
+    uint32_t small = pair.ties_up ? magnitude0 : magnitude1, large = pair.ties_up ? magnitude1 : magnitude0;
+    uint32_t small_exponent = small >> 23, large_exponent = large >> 23;
+    pair.small = (small & 0x7FFFFFu) | (small_exponent ? 0x800000u : 0);
+    pair.large = (large & 0x7FFFFFu) | (large_exponent ? 0x800000u : 0);
+    small_exponent += small_exponent == 0, large_exponent += large_exponent == 0; /* denormals: 2^-149 units */
+    pair.gap = small ? large_exponent - small_exponent : 0;
+    pair.plain = (uint32_t)(bits0 <= 0x80000000u) & (uint32_t)(bits1 <= 0x80000000u) & /* >= 0 or -0 */
+                 (uint32_t)(large < 0x7F800000u) & (uint32_t)(large != 0);
+    return pair;
+}
+
+/* The largest gap sp_grid_round_pair takes: D < 2^(25 + gap) = 2^60, and its remainders fit 63
+ * bits (below). */
+#define SP_GRID_PAIR_GAP 35
+
+/*
+ * The K = 2 rounding of grids s >= SP_GRID_DOUBLE_LIMIT, exact: x = s small / D for the smaller
+ * weight and D = large 2^gap + small (so x <= s/2 < 2^63, and x < 2^(65 - gap) for gap > 0, as
+ * the larger weight is then normal) rounded to the nearest integer, ties as sp_grid_pair says;
+ * q = (s - that, that). A double estimate f of x (5 roundings: within 2^-50 x + 1 of it), the
+ * remainder s small - f D exactly (|r| < (2^(15 - gap) + 2) D < 2^62, so modulo 2^64 is exact),
+ * f corrected by r / D in double (within 2^-35 of the truth, so the remainder is then below
+ * 1.01 D) and a last +-1 from the exact remainder's comparison with D/2.
+ * Returns 0, q untouched, for input that is not plain or has a gap past SP_GRID_PAIR_GAP: the
+ * general rounding decides those.
+ */
+SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, uint64_t* q)
+{
+    sp_grid_pair pair = sp_grid_pair_parts(weights);
+    if (!pair.plain || pair.gap > SP_GRID_PAIR_GAP) return 0;
+    uint64_t sum = (pair.large << pair.gap) + pair.small;
+    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * (double)s * inverse;
+    int64_t whole = (int64_t)(estimate < 0x1.fffffffffffffp62 ? estimate : 0x1.fffffffffffffp62);
+    int64_t rest = (int64_t)(s * pair.small - (uint64_t)whole * sum);
+    int64_t steps = (int64_t)((double)rest * inverse);
+    whole += steps;
+    rest -= steps * (int64_t)sum; /* |rest| < 1.01 D */
+    int64_t twice = 2 * rest + (int64_t)pair.ties_up, d = (int64_t)sum;
+    uint64_t nearest = (uint64_t)(whole + (twice > d) - (twice <= -d));
+    q[0] = s - nearest;
+    q[1] = nearest;
+    return 1;
+}
+
 /* Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s:
- * sp_grid_round where it applies, else the general rounding. */
+ * sp_grid_round where it applies, sp_grid_round_pair for K = 2 on larger grids, else the general
+ * rounding. */
 SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
-    if (s < SP_GRID_DOUBLE_LIMIT && sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
+    if (s < SP_GRID_DOUBLE_LIMIT) {
+        if (sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
+    } else if (k == 2 && sp_grid_round_pair(weights, s, q))
+        return;
     sp_grid_quantize_general(weights, k, s, q);
 }
 

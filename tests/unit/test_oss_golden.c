@@ -59,7 +59,9 @@ typedef struct golden_row {
     uint64_t encode, decode, sampled;
 } golden_row;
 
-/* Recorded from commit 2cc7f20 (test_oss_golden --print built against it). */
+/* Recorded from commit 2cc7f20 (test_oss_golden --print built against it), but for K = 2 at 64
+ * bits (63-bit codes), re-recorded when that grid's rounding became exact (issue 14): 8 of its
+ * vertices were off the nearest grid point before. */
 static const golden_row golden[] = {
 #include "test_oss_golden.inc"
 };
@@ -108,7 +110,9 @@ typedef struct odd_row {
 } odd_row;
 
 /* Recorded from commit 7598b78 (test_oss_golden --print-odd built against it), before the
- * scalar encoder's rounding was split into scale and round steps. */
+ * scalar encoder's rounding was split into scale and round steps; the K = 2 rows of grids past
+ * 2^50 (Cube 64, POT 52 and 64, OSS 52 and 64 bits) re-recorded when their rounding became exact
+ * (issue 14): only finite non-negative pairs changed, each to test_oss_exact's exact result. */
 static const odd_row odd_golden[] = {
 #include "test_oss_golden_odd.inc"
 };
