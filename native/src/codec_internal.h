@@ -108,7 +108,7 @@ SP_INLINE sp_grid_pair sp_grid_pair_parts(const float* weights)
     pair.small = (small & 0x7FFFFFu) | (small_exponent ? 0x800000u : 0);
     pair.large = (large & 0x7FFFFFu) | (large_exponent ? 0x800000u : 0);
     small_exponent += small_exponent == 0, large_exponent += large_exponent == 0; /* denormals: 2^-149 units */
-    pair.gap = small ? large_exponent - small_exponent : 0;
+    pair.gap = (large_exponent - small_exponent) * (uint32_t)(small != 0); /* no branch: zero weights are common */
     pair.plain = (uint32_t)(bits0 <= 0x80000000u) & (uint32_t)(bits1 <= 0x80000000u) & /* >= 0 or -0 */
                  (uint32_t)(large < 0x7F800000u) & (uint32_t)(large != 0);
     return pair;
@@ -126,22 +126,29 @@ SP_INLINE sp_grid_pair sp_grid_pair_parts(const float* weights)
  * remainder s small - f D exactly (|r| < (2^(15 - gap) + 2) D < 2^62, so modulo 2^64 is exact),
  * f corrected by r / D in double (within 2^-35 of the truth, so the remainder is then below
  * 1.01 D) and a last +-1 from the exact remainder's comparison with D/2.
- * Returns 0, q untouched, for input that is not plain or has a gap past SP_GRID_PAIR_GAP: the
- * general rounding decides those.
+ * grid is s as a double (a loop's constant). Returns 0, q untouched, for input that is not plain
+ * or has a gap past SP_GRID_PAIR_GAP: the general rounding decides those.
  */
-SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, uint64_t* q)
+SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, double grid, uint64_t* q)
 {
     sp_grid_pair pair = sp_grid_pair_parts(weights);
     if (!pair.plain || pair.gap > SP_GRID_PAIR_GAP) return 0;
-    uint64_t sum = (pair.large << pair.gap) + pair.small;
-    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * (double)s * inverse;
-    int64_t whole = (int64_t)(estimate < 0x1.fffffffffffffp62 ? estimate : 0x1.fffffffffffffp62);
+    uint64_t sum = (pair.large << pair.gap) + pair.small, nearest;
+#if SP_NARROW_DIVIDE
+    uint64_t rest, whole = sp_u128_divide_narrow(sp_u128_mul_u64(sp_u128_from(s), pair.small), sum, &rest);
+    nearest = whole + (2 * rest + pair.ties_up > sum);
+    (void)grid;
+#else
+    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * grid * inverse;
+    estimate = estimate < 0x1.fffffffffffffp62 ? estimate : 0x1.fffffffffffffp62; /* (int64_t) stays defined */
+    int64_t whole = (int64_t)estimate;
     int64_t rest = (int64_t)(s * pair.small - (uint64_t)whole * sum);
     int64_t steps = (int64_t)((double)rest * inverse);
     whole += steps;
     rest -= steps * (int64_t)sum; /* |rest| < 1.01 D */
     int64_t twice = 2 * rest + (int64_t)pair.ties_up, d = (int64_t)sum;
-    uint64_t nearest = (uint64_t)(whole + (twice > d) - (twice <= -d));
+    nearest = (uint64_t)(whole + (twice > d) - (twice <= -d));
+#endif
     q[0] = s - nearest;
     q[1] = nearest;
     return 1;
@@ -155,7 +162,7 @@ SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, ui
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
     if (s < SP_GRID_DOUBLE_LIMIT) {
         if (sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
-    } else if (k == 2 && sp_grid_round_pair(weights, s, q))
+    } else if (k == 2 && sp_grid_round_pair(weights, s, (double)s, q))
         return;
     sp_grid_quantize_general(weights, k, s, q);
 }

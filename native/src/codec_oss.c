@@ -179,18 +179,30 @@ SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, si
     }
 }
 
-/* The scalar encode with k constant: grids from SP_GRID_DOUBLE_LIMIT (K = 2 codes past 50 bits)
- * round in long double, one vertex at a time; the others in chunks. */
+/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_round_pair, the code q[1];
+ * the pairs it leaves to the general rounding one at a time. */
+static void oss_encode_wide_pairs(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                                  uint64_t* codes, uint8_t* significant)
+{
+    uint64_t s = codec->scale;
+    double grid = (double)s;
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[2];
+        if (!sp_grid_round_pair(weights + v * 2, s, grid, q)) sp_grid_quantize_general(weights + v * 2, 2, s, q);
+        if (significant) significant[v] = (uint8_t)(1 + (q[1] > 0));
+        codes[v] = q[1];
+    }
+}
+
+/* The scalar encode with k constant: K = 2 codes past 50 bits by oss_encode_wide_pairs, the
+ * others in chunks (no grid of K = 3, 4 reaches SP_GRID_DOUBLE_LIMIT). */
 SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
                               uint64_t* codes, uint8_t* significant, uint32_t k)
 {
     if (codec->scale >= SP_GRID_DOUBLE_LIMIT) {
-        for (size_t v = first; v < count; ++v) {
-            uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            sp_grid_quantize(weights + v * k, k, codec->scale, q);
-            if (significant) significant[v] = sp_grid_significant(q, k);
-            codes[v] = oss_pack(codec->n, k, q);
-        }
+        if (k == 2) oss_encode_wide_pairs(codec, weights, first, count, codes, significant);
+        else
+            for (size_t v = first; v < count; ++v) codes[v] = sp_oss_encode_one(codec, weights + v * k, significant ? significant + v : NULL);
     } else if (codec->n < (k == 4 ? OSS_LAYER64_N : OSS_ROW64_N))
         oss_encode_chunks(codec, weights, first, count, codes, significant, k, 1);
     else
