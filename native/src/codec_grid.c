@@ -129,10 +129,10 @@ SP_INLINE void quantize_general(const float* weights, uint32_t k, uint64_t s, ui
         }
 }
 
-/* quantize_general for k = 2, what odd input (not plain, see sp_grid_pair) takes:
- * the same floors, and for a deficit d (s - q0 - q1 >= 0) the same d/2 each and the odd one to
- * the larger remainder (ties to slot 0), as selects: d is 0 or 1 at random, which a branch
- * mispredicts. A sum past s (degenerate input) takes the general code. */
+/* quantize_general for k = 2, what odd input (not plain, see sp_grid_pair; its results are kept
+ * as they were) takes on every grid, and any input on grids below SP_GRID_DOUBLE_LIMIT: the same
+ * floors, and for a deficit d (s - q0 - q1 >= 0) the same d/2 each and the odd one to the larger
+ * remainder (ties to slot 0), as selects. A sum past s (degenerate input) takes the general code. */
 SP_INLINE void quantize_pair(const float* weights, uint64_t s, uint64_t* q)
 {
     double remainder[2], sum = 0;
@@ -155,8 +155,10 @@ SP_INLINE void quantize_pair(const float* weights, uint64_t s, uint64_t* q)
 
 /* sp_grid_round_pair's exact rounding for plain pairs of any gap, in 128 bits: a gap past 66
  * puts x below 1/4 (x < s small / (large 2^gap) < 2^64 2^24 / 2^(23 + gap), the larger weight
- * being normal), else D < 2^91 and s small < 2^88, floor and remainder by division. Returns 0 for
- * input that is not plain. */
+ * being normal), else D < 2^91 and s small < 2^88, floor and remainder by division. Past a gap of
+ * 23 no x is a tie (that needs the two weights' lowest set bits at the same place, large's is at
+ * least gap places up), so the tie rule only matters in sp_grid_round_pair. Returns 0 for input
+ * that is not plain. */
 static int quantize_pair_exact(const float* weights, uint64_t s, uint64_t* q)
 {
     sp_grid_pair pair = sp_grid_pair_parts(weights);
