@@ -1,10 +1,13 @@
 /*
- * OSS batch dispatch: which vector path (codec_oss_batch_avx512.c, codec_oss_batch_avx2.c, one
- * driver in codec_oss_simd.h) takes a prefix of a batch, for which codecs. The paths are exact
- * where every OSS intermediate stays below 2^50 in double lanes; wider codes take the scalar
- * loop in codec.c.
+ * OSS batch dispatch: which vector path takes a prefix of a batch, for which codecs. The
+ * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
+ * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
+ * lanes, up to 64-bit codes. Both per ISA in codec_oss_wide_avx512.c and codec_oss_wide_avx2.c.
+ * What no vector path takes (K = 2 encode past N = 2^49, whose rounding is long double) is left to
+ * the scalar loop in codec.c.
  */
 #include "codec_internal.h"
+#include "codec_oss_wide.h"
 
 /* Largest N per K for which the double lanes are exact (codec_oss_simd.h): every value with a
  * fractional quarter or half (row and layer numerators, the row root's argument) below 2^51,
@@ -16,18 +19,30 @@
 #define BATCH_MAX_N3 ((uint64_t)1 << 24)
 #define BATCH_MAX_N4 ((uint64_t)3 << 15)
 
-int sp_oss_batch_supported(const sp_codec* codec)
+/* Which lanes a codec takes: none, the double lanes, or the wide ones (past the double lanes'
+ * N, every N of a 64-bit code: K = 3 grid coordinates below 2^35, K = 4 layers below 2^23, whose
+ * in-layer indices stay below 2^47 in double). */
+typedef enum { LANES_NONE, LANES_DOUBLE, LANES_WIDE } oss_lanes;
+
+static oss_lanes oss_lanes_for(const sp_codec* codec, int encode)
 {
     uint32_t k = codec->influences;
-    if (codec->method != SP_METHOD_OSS || k < 2 || k > 4) return 0;
+    if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return LANES_NONE;
     uint64_t limit = k == 2 ? BATCH_MAX_N2 : (k == 3 ? BATCH_MAX_N3 : BATCH_MAX_N4);
-    return codec->n >= 2 && codec->n <= limit;
+    if (codec->n <= limit) return LANES_DOUBLE;
+    if (k == 2 && encode && codec->n > SP_OSS_WIDE_MAX_N2_ENCODE) return LANES_NONE;
+    return LANES_WIDE;
+}
+
+int sp_oss_batch_supported(const sp_codec* codec)
+{
+    return oss_lanes_for(codec, 1) != LANES_NONE && oss_lanes_for(codec, 0) != LANES_NONE;
 }
 
 /* The widest path this CPU, the caller and the codec allow. */
-static sp_isa batch_isa(const sp_codec* codec, sp_isa widest)
+static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
 {
-    if (!sp_oss_batch_supported(codec)) return SP_ISA_SCALAR;
+    if (lanes == LANES_NONE) return SP_ISA_SCALAR;
     sp_isa cpu = sp_cpu_isa();
     return cpu < widest ? cpu : widest;
 }
@@ -40,11 +55,16 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 {
     size_t done = 0;
 #if SP_X86_SIMD
-    sp_isa isa = batch_isa(codec, widest);
-    if (isa >= SP_ISA_AVX512) done = sp_oss_encode_avx512(codec, weights, count, codes, significant);
+    oss_lanes lanes = oss_lanes_for(codec, 1);
+    sp_isa isa = batch_isa(lanes, widest);
+    size_t (*avx512)(const sp_codec*, const float*, size_t, uint64_t*, uint8_t*) =
+        lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
+    size_t (*avx2)(const sp_codec*, const float*, size_t, uint64_t*, uint8_t*) =
+        lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
+    if (isa >= SP_ISA_AVX512) done = avx512(codec, weights, count, codes, significant);
     if (isa >= SP_ISA_AVX2 && done < count)
-        done += sp_oss_encode_avx2(codec, weights + done * codec->influences, count - done, codes + done,
-                                   significant ? significant + done : NULL);
+        done += avx2(codec, weights + done * codec->influences, count - done, codes + done,
+                     significant ? significant + done : NULL);
 #else
     (void)codec, (void)weights, (void)count, (void)codes, (void)significant, (void)widest, (void)batch_isa;
 #endif
@@ -55,10 +75,14 @@ size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t 
 {
     size_t done = 0;
 #if SP_X86_SIMD
-    sp_isa isa = batch_isa(codec, widest);
-    if (isa >= SP_ISA_AVX512) done = sp_oss_decode_avx512(codec, codes, count, weights);
-    if (isa >= SP_ISA_AVX2 && done < count)
-        done += sp_oss_decode_avx2(codec, codes + done, count - done, weights + done * codec->influences);
+    oss_lanes lanes = oss_lanes_for(codec, 0);
+    sp_isa isa = batch_isa(lanes, widest);
+    size_t (*avx512)(const sp_codec*, const uint64_t*, size_t, float*) =
+        lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
+    size_t (*avx2)(const sp_codec*, const uint64_t*, size_t, float*) =
+        lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
+    if (isa >= SP_ISA_AVX512) done = avx512(codec, codes, count, weights);
+    if (isa >= SP_ISA_AVX2 && done < count) done += avx2(codec, codes + done, count - done, weights + done * codec->influences);
 #else
     (void)codec, (void)codes, (void)count, (void)weights, (void)widest;
 #endif

@@ -7,10 +7,11 @@
  * sp_oss_unpack + sp_grid_to_weights): the rounding runs in double lanes with the scalar's
  * exact operation order, and the OSS index arithmetic runs in double lanes too, where every
  * intermediate is an integer or a quarter small enough (codec_oss_batch.c) to be exact in any order (Horner forms,
- * explicit FMAs). Decode's layer and row *estimates* differ from the scalar ones (no layer
- * square root, no divisions, shifted arguments): exact integer checks decide every lane. A lane
- * whose inputs leave that exact regime (odd weights, a code the estimate misses) is redone by
- * the scalar code, so the vector code only ever has to be right where it claims to be.
+ * explicit FMAs); narrow codes decode in int32 / float lanes instead (see "decode in 32-bit
+ * lanes"). Decode's layer and row *estimates* differ from the scalar ones (no layer square
+ * root, no divisions, shifted arguments): exact integer checks decide every lane. A lane whose
+ * inputs leave that exact regime (odd weights, a code the estimate misses) is redone by the
+ * scalar code, so the vector code only ever has to be right where it claims to be.
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN):
  *   vec, mask          BLOCK double lanes and a lane mask; BLOCK, ENCODE_CHUNK, DECODE_CHUNK,
@@ -19,9 +20,22 @@
  *   v_splat v_zero v_add v_sub v_mul v_div v_sqrt v_max v_min v_floor v_trunc
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
  *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
- *   load_weights, store_weights (AoS floats <-> K vectors), load_codes, store_codes (u64),
- *   store_counts (lane values as bytes), codes_valid (every code <= max_code)
+ *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
+ *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
+ *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
+ *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
+ *   store_codes (u64),
+ *   code_check, check_start(max_code), load_codes(codes, check) (each checked <= max_code),
+ *   check_passed, store_counts (lane values as bytes), codes_valid (every code of a block
+ *   <= max_code)
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
+ * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
+ *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
+ *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
+ *   i_shr2 (arithmetic >> 2), i_div9 (floor(a / 9), 0 <= a < 2^31), i_gt, n_or, n_bits,
+ *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
+ *   load_codes32(codes, check) (the low halves of NBLOCK codes, each checked <= max_code,
+ *   which is below 2^31 there), store_weights32 (as store_weights, of the scale)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -54,23 +68,39 @@ SP_INLINE SIMD_FN vec layer_base(double n, vec k)
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
-/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain. */
+/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain.
+ * The scalar sums from 0 + w0, which differs from w0 only for w0 = -0, and then only if all
+ * weights are -0 does the sum: scale = -inf instead of +inf, and every x NaN either way (a
+ * lane the rounding redoes). */
 SP_INLINE SIMD_FN vec quantize_scale(const vec* w, uint32_t k, double s)
 {
-    vec sum = v_zero();
+    vec sum = w[0];
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) sum = v_add(sum, w[i]); /* 0 + w0 first: keeps -0 as the scalar does */
+    for (uint32_t i = 1; i < k; ++i) sum = v_add(sum, w[i]);
     return v_div(v_splat(s), sum);
 }
 
-/* sp_grid_quantize's floors x = max(w s / sum, 0) -> q = trunc(x), remainder = x - q, same
- * operations in the same order; returns the deficit s - sum of q. */
+/* The lanes whose weights are sorted and non-negative (no NaN), as bits: the only ones the
+ * vector encode keeps. There w s / sum >= 0 (or NaN, where the sum is 0), so the scalar's
+ * max(x, 0) is x (-0 for -0, equal for every later use), and the floors are sorted too, which
+ * the rounding keeps (for equal floors the earlier remainder is not smaller, so it wins), so
+ * the index is the scalar's: for unsorted q the scalar wraps around. */
+SP_INLINE SIMD_FN unsigned weights_ordered(const vec* w, uint32_t k)
+{
+    mask ok = m_ge(w[k - 1], v_zero());
+    SP_UNROLL
+    for (uint32_t i = 1; i < k; ++i) ok = m_and(ok, m_ge(w[i - 1], w[i]));
+    return m_bits(ok);
+}
+
+/* sp_grid_quantize's floors x = w s / sum -> q = trunc(x), remainder = x - q, same operations
+ * in the same order for the ordered lanes; returns the deficit s - sum of q. */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
     vec deficit = v_splat(s);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_max(v_mul(w[i], scale), v_zero()); /* max returns its second operand for NaN: x > 0 ? x : 0 */
+        vec x = v_mul(w[i], scale);
         q[i] = v_trunc(x);
         remainder[i] = v_sub(x, q[i]);
         deficit = v_sub(deficit, q[i]);
@@ -80,31 +110,33 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
 
 /*
  * sp_grid_quantize's last step: the deficit goes, one each, to the components with the largest
- * remainders (ties to the lower index), chosen by rank. Returns the lanes the fast path is exact
+ * remainders (ties to the lower index), chosen by rank; q[0], which the index and the
+ * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
  * for: a deficit in [0, k), where the scalar takes the same path. That also bounds every x by
  * s + 1, so floors and deficit are exact: an x past that makes the deficit negative, and one
  * past 2^53 (or infinite) keeps it so under rounding. Other lanes get some q: they are redone.
  */
 SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remainder, vec* q)
 {
-    vec rank[SP_MAX_INFLUENCES], one = v_splat(1.0);
+    counter rank[SP_MAX_INFLUENCES]; /* from 0 to k - 1, so the counters never leave their range */
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) rank[i] = v_splat((double)(k - 1 - i)); /* every later slot beats i ... */
+    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(k - 1 - i); /* every later slot beats i ... */
     SP_UNROLL
     for (uint32_t a = 0; a < k; ++a) { /* ... unless i wins against it; an earlier slot a beats b when it wins */
         SP_UNROLL
         for (uint32_t b = a + 1; b < k; ++b) {
             mask a_wins = m_ge(remainder[a], remainder[b]);
-            rank[a] = v_add_where(rank[a], a_wins, v_splat(-1.0));
-            rank[b] = v_add_where(rank[b], a_wins, one);
+            rank[a] = c_dec_where(rank[a], a_wins);
+            rank[b] = c_inc_where(rank[b], a_wins);
         }
     }
+    vec threshold = c_threshold(deficit), one = v_splat(1.0);
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) q[i] = v_add_where(q[i], m_gt(deficit, rank[i]), one);
+    for (uint32_t i = 1; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one); /* q[0] is implied */
     return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
 }
 
-/* sp_oss_pack on sorted lanes (the caller masks unsorted ones: the scalar wraps around there). */
+/* sp_oss_pack on sorted lanes (the caller masks the others). */
 SP_INLINE SIMD_FN vec pack_block(const vec* q, uint32_t k, double n)
 {
     if (k == 2) return q[1];
@@ -123,14 +155,11 @@ SP_INLINE SIMD_FN void store_significant(const vec* q, uint32_t k, uint8_t* out)
     store_counts(count, out);
 }
 
-/* The rounding of one block's floors and the sorted check: the lanes the vector code cannot
- * prove exact, as bits. */
-SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q)
+/* The rounding of one block's floors: the lanes the vector code cannot prove exact (outside
+ * `ordered`, or past the fast path's deficits), as bits. */
+SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q, unsigned ordered)
 {
-    mask ok = quantize_round(k, deficit, remainder, q);
-    SP_UNROLL
-    for (uint32_t i = 1; i < k; ++i) ok = m_and(ok, m_ge(q[i - 1], q[i]));
-    return ~m_bits(ok) & ((1u << BLOCK) - 1);
+    return ~(m_bits(quantize_round(k, deficit, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
 }
 
 /* The indices (and counts) of one block's sorted lanes. */
@@ -152,24 +181,25 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const float* weights,
     double s = (double)codec->scale, n = (double)codec->n;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK], deficit[ENCODE_CHUNK];
     vec q[ENCODE_CHUNK][SP_MAX_INFLUENCES], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
-    unsigned missed[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, s);
+        ordered[b] = weights_ordered(w[b], k);
     }
     if (ENCODE_FUSED)
         for (size_t b = 0; b < blocks; ++b) {
             deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
         }
     else {
         for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-        for (size_t b = 0; b < blocks; ++b) missed[b] = round_block(k, deficit[b], remainder[b], q[b]);
+        for (size_t b = 0; b < blocks; ++b) any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
         for (size_t b = 0; b < blocks; ++b)
             store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
-    for (size_t b = 0; b < blocks; ++b)
+    for (size_t b = 0; any && b < blocks; ++b) /* any: most chunks have no lane to redo */
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
 }
@@ -263,28 +293,46 @@ SP_INLINE SIMD_FN vec row_offset(vec bottom, vec j, vec w, mask* ok)
 SP_INLINE SIMD_FN void unpacked_block(double n, uint32_t k, vec layer, vec row, vec i, vec* q)
 {
     if (k == 4) q[3] = layer;
-    q[2] = v_add(row, layer);
+    q[2] = k == 4 ? v_add(row, layer) : row;
     q[1] = v_add(i, q[2]);
     vec sum = v_add(q[1], q[2]);
     q[0] = v_sub(v_splat(2 * (n - 1)), k == 4 ? v_add(sum, layer) : sum);
 }
 
-/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes <= max_code, in stages
- * (the layer root's two halves, the row, the rest), then the scalar redo of the lanes it missed.
- * Every array entry is written in a stage before a later one reads it.
+/* The last stage's grid components of one block (layer and bottom unused for K = 2, 3) and
+ * the lanes the row check rejects, as bits. */
+SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bottom, vec row, vec rest, vec* q)
+{
+    if (k == 2) {
+        q[1] = rest;
+        q[0] = v_sub(v_splat(2 * (n - 1)), rest);
+        return 0;
+    }
+    mask ok;
+    vec i = row_offset(k == 4 ? bottom : v_splat(n), row, rest, &ok);
+    unpacked_block(n, k, k == 4 ? layer : v_zero(), row, i, q);
+    return ~m_bits(ok) & ((1u << BLOCK) - 1);
+}
+
+/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages (the layer
+ * root's two halves, the row, the rest), then the scalar redo of the lanes it missed. Every
+ * array entry is written in a stage before a later one reads it. The codes are checked against
+ * max_code as they are loaded: a chunk with an invalid one is left unwritten (returns 0).
  *
  * The layer needs no check of its own: with k clamped to the layers, the row check accepts
  * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
  * and then (k, row, i) is the one tuple whose index is code. */
-SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
-                                    uint32_t k, const simd_layout* layout)
+SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                   uint32_t k, const simd_layout* layout)
 {
     double n = (double)codec->n, inverse = 1.0 / (double)codec->scale;
     vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
     root z[DECODE_CHUNK];
-    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
-    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK);
+    unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK, &check);
+    if (!check_passed(&check)) return 0; /* nothing written yet */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = layer_argument(n, rest[b]);
@@ -297,43 +345,184 @@ SP_INLINE SIMD_FN void decode_chunk(const sp_codec* codec, const uint64_t* codes
             if (k == 4) {
                 rest[b] = v_sub(rest[b], layer_base(n, layer[b]));
                 bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(n));
-            } else {
-                layer[b] = v_zero();
-                bottom[b] = v_splat(n);
             }
-            row[b] = row_estimate(bottom[b], rest[b]);
+            row[b] = row_estimate(k == 4 ? bottom[b] : v_splat(n), rest[b]); /* K = 3: one triangle, constants */
         }
-    for (size_t b = 0; b < blocks; ++b) {
+    size_t b = 0;
+    for (; b + 1 < blocks; b += 2) { /* two blocks a step: store_pair may store them faster together */
+        vec first[SP_MAX_INFLUENCES], second[SP_MAX_INFLUENCES];
+        any |= missed[b] = decoded_block(n, k, layer[b], bottom[b], row[b], rest[b], first);
+        any |= missed[b + 1] = decoded_block(n, k, layer[b + 1], bottom[b + 1], row[b + 1], rest[b + 1], second);
+        store_pair(first, second, k, inverse, layout, weights + b * BLOCK * k);
+    }
+    if (b < blocks) {
         vec q[SP_MAX_INFLUENCES];
-        if (k == 2) {
-            q[1] = rest[b];
-            q[0] = v_sub(v_splat(2 * (n - 1)), rest[b]);
-            missed[b] = 0;
-        } else {
-            mask ok;
-            vec i = row_offset(bottom[b], row[b], rest[b], &ok);
-            unpacked_block(n, k, layer[b], row[b], i, q);
-            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
-        }
+        any |= missed[b] = decoded_block(n, k, layer[b], bottom[b], row[b], rest[b], q);
         store_weights(q, k, inverse, layout, weights + b * BLOCK * k);
     }
-    for (size_t b = 0; b < blocks; ++b)
+    for (size_t b = 0; any && b < blocks; ++b)
         for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+    return 1;
+}
+
+/* ---- decode in 32-bit lanes ------------------------------------------------------------- */
+
+/*
+ * Narrow codes (K = 3 up to N = NARROW_MAX_N3, K = 4 up to NARROW_MAX_N4: codes of up to 24
+ * and 25 bits) decode in int32 / float lanes, twice as many a register as doubles. The exact
+ * parts run in int32, where every intermediate is an integer below 2^31: the row base
+ * ((4B + 2 - 3j) j + 1) / 4 < (4B + 2)^2 / 12, the row root's argument apex^2 - 12 w, the layer
+ * numerator 9 u(k) + r < 2^31 (its floor by 9 through a 32 x 32-bit product, i_div9); the row
+ * and layer estimates run in float, as estimates only: an estimate that misses (more often than
+ * in double: ~3e-4 of random K = 3 codes at 24 bits) fails the same exact row check and is
+ * redone by the scalar code. The weights are the correctly rounded q/s (store_weights32), which
+ * the double product of the scalar code is too for these q and s.
+ */
+#define NARROW_MAX_N3 8192 /* apex^2 and 12 w < 2^28.1; codes < 2^24.5 */
+#define NARROW_MAX_N4 1024 /* 9 u((N + 1) / 2) < 2^29.1, 8 (N + 1)^3 < 2^33.1 (float); codes < 2^26 */
+
+SP_INLINE int narrow_decode(const sp_codec* codec, uint32_t k)
+{
+    return (k == 3 && codec->n <= NARROW_MAX_N3) || (k == 4 && codec->n <= NARROW_MAX_N4);
+}
+
+/* s_B(j) = ((4B + 2 - 3j) j + 1) / 4 (floor: the numerator is positive) with 4B + 2 = 2 apex. */
+SP_INLINE SIMD_FN nint n_row_base(nint apex, nint three_j, nint j)
+{
+    nint slope = i_sub(i_add(apex, apex), three_j);
+    return i_shr2(i_add(i_mullo(slope, j), i_splat(1)));
+}
+
+/* cbrt(x) + 1/cbrt(x) in float to ~1e-7 (x >= 1; garbage lanes for others, which the row check
+ * rejects): z ~ x^(-1/3) by the exponent/3 bit trick and two third-order steps
+ * z (1 + r/3 + 2r^2/9), r = 1 - x z^3 (n_root_step), then c = x z^2 and c + z. */
+SP_INLINE SIMD_FN nvec n_root_step(nvec x, nvec z)
+{
+    nvec xz = f_mul(x, z), r = f_fnmadd(xz, f_mul(z, z), f_splat(1.0f));
+    return f_fmadd(f_mul(z, r), f_fmadd(r, f_splat(2.0f / 9.0f), f_splat(1.0f / 3.0f)), z);
+}
+
+/* The layer root's argument x for each code (layer_argument) and a first z ~ x^(-1/3). */
+SP_INLINE SIMD_FN nvec n_layer_start(double n, nint code, nvec* z)
+{
+    double m = n + 1;
+    nvec x = f_fnmadd(i_to_f(code), f_splat(144.0f), f_splat((float)(8 * m * m * m + 12 * m * m - 106)));
+    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
+    *z = n_root_step(x, i_as_f(i_sub(i_splat(1419916032), third)));
+    return x;
+}
+
+/* The layer of each code from x and z, as layer_estimate. */
+SP_INLINE SIMD_FN nint n_layer_finish(double n, nvec x, nvec z)
+{
+    z = n_root_step(x, z);
+    nvec estimate = f_fnmadd(f_fmadd(f_mul(x, z), z, z), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4)));
+    return i_min(i_max(i_trunc(estimate), i_splat(0)), i_splat((int32_t)(((uint64_t)n + 1) / 2 - 1)));
+}
+
+/* u(k) as layer_base: 9 u(k) + r = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2, the inner factor
+ * positive; four_k = 4k. */
+SP_INLINE SIMD_FN nint n_layer_base(double n, nint layer, nint four_k)
+{
+    nint a = i_add(i_mullo(i_sub(four_k, i_splat((int32_t)(6 * n + 9))), layer), i_splat((int32_t)(3 * n * n + 9 * n + 6)));
+    return i_div9(i_add(i_mullo(a, layer), i_splat(2)));
+}
+
+/* The row estimate (row_estimate: the mirrored root for w + 7/8, apex^2 + 3 - 10.5 - 12 w),
+ * the argument exact in int32, the root in float; trunc and floor agree after the clamp. */
+SP_INLINE SIMD_FN nint n_row_estimate(nint apex, nint w)
+{
+    nint mirrored = i_sub(i_mullo(apex, apex), i_add(i_mullo(w, i_splat(12)), i_splat(8)));
+    nvec root = f_sqrt(f_add(i_to_f(mirrored), f_splat(0.5f)));
+    return i_max(i_trunc(f_mul(f_sub(i_to_f(apex), root), f_splat(1.0f / 3.0f))), i_splat(0)); /* NaN: 0 */
+}
+
+/* Grid components of one block from layer, row estimate and rest (row_offset's check: the lanes
+ * where i = w - s_B(j) is not in [0, (2B - 3j) / 2) come back as bits). */
+SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex, nint row, nint w, nint* q)
+{
+    nint three_j = i_add(row, i_add(row, row));
+    nint i = i_sub(w, n_row_base(apex, three_j, row));
+    nint last = i_sub(i_sub(apex, i_splat(3)), three_j); /* 2B - 2 - 3j */
+    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i_add(i, i), last)));
+    if (k == 4) q[3] = layer;
+    q[2] = k == 4 ? i_add(row, layer) : row;
+    q[1] = i_add(i, q[2]);
+    nint sum = i_add(q[1], q[2]);
+    q[0] = i_sub(i_splat((int32_t)(2 * (n - 1))), k == 4 ? i_add(sum, layer) : sum);
+    return missed;
+}
+
+/* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there;
+ * the codes are checked against max_code as they are loaded, and a chunk holding an invalid
+ * one is left to the caller, unwritten (returns 0). */
+SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const uint64_t* codes, size_t blocks, float* weights,
+                                          uint32_t k, const simd_layout* layout)
+{
+    double n = (double)codec->n, scale = (double)codec->scale;
+    nint layer[NARROW_CHUNK], rest[NARROW_CHUNK], apex[NARROW_CHUNK], row[NARROW_CHUNK];
+    unsigned missed[NARROW_CHUNK], any = 0; /* lanes as bits */
+    nvec x[NARROW_CHUNK], z[NARROW_CHUNK];
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) {
+        rest[b] = load_codes32(codes + b * NBLOCK, &check);
+        if (k == 4) x[b] = n_layer_start(n, rest[b], &z[b]);
+    }
+    if (!check_passed(&check)) return 0; /* nothing written yet */
+    if (k == 4)
+        for (size_t b = 0; b < blocks; ++b) layer[b] = n_layer_finish(n, x[b], z[b]);
+    for (size_t b = 0; b < blocks; ++b) { /* the layer base in a stage of its own: the root's chain is long */
+        apex[b] = i_splat((int32_t)(2 * n + 1));
+        if (k == 4) {
+            nint four_k = i_add(i_add(layer[b], layer[b]), i_add(layer[b], layer[b]));
+            rest[b] = i_sub(rest[b], n_layer_base(n, layer[b], four_k));
+            apex[b] = i_sub(apex[b], four_k); /* 2(N - 2k) + 1 */
+        }
+        row[b] = n_row_estimate(apex[b], rest[b]);
+    }
+    for (size_t b = 0; b < blocks; ++b) {
+        nint q[SP_MAX_INFLUENCES];
+        missed[b] = n_unpack(n, k, k == 4 ? layer[b] : i_splat(0), apex[b], row[b], rest[b], q);
+        any |= missed[b];
+        store_weights32(q, k, scale, layout, weights + b * NBLOCK * k);
+    }
+    for (size_t b = 0; any && b < blocks; ++b)
+        for (size_t lane = b * NBLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+    return 1;
+}
+
+/* The chunks of narrow codes up to the first chunk holding an invalid code (decode_blocks
+ * finds it block by block). */
+SP_INLINE SIMD_FN size_t decode_narrow(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                       uint32_t k, const simd_layout* layout)
+{
+    size_t v = 0;
+    while (v + NBLOCK <= count) {
+        size_t blocks = (count - v) / NBLOCK;
+        if (blocks > NARROW_CHUNK) blocks = NARROW_CHUNK;
+        if (!decode_chunk_narrow(codec, codes + v, blocks, weights + v * k, k, layout)) break;
+        v += blocks * NBLOCK;
+    }
+    return v;
 }
 
 SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                                        uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    size_t v = 0;
+    size_t v = narrow_decode(codec, k) ? decode_narrow(codec, codes, count, weights, k, &layout) : 0;
     while (v + BLOCK <= count) {
         size_t blocks = (count - v) / BLOCK, valid = 0;
         if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
-        while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
-        if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
-        decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
-        v += valid * BLOCK;
+        if (!decode_chunk(codec, codes + v, blocks, weights + v * k, k, &layout)) {
+            /* an invalid code: the blocks before its block, then the scalar loop reports it */
+            while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
+            if (valid) decode_chunk(codec, codes + v, valid, weights + v * k, k, &layout);
+            return v + valid * BLOCK;
+        }
+        v += blocks * BLOCK;
     }
     return v;
 }

@@ -3,11 +3,11 @@
  *
  * Greedy growth leaves a few underfull meshlets behind (slivers between finished meshlets, the
  * ends of thin parts). The builder first records its meshlets as a plan (triangle lists, nothing
- * written); then each underfull meshlet, smallest first, is merged with the nearest underfull
- * meshlet (in the Morton order of their first triangles, a window on each side) that fits
- * together with it within every limit, the palette cap included. Every merge saves one meshlet
- * and never adds a palette entry (the union of two palettes is at most their sum). The plan is
- * then refined and written out by meshlets_refine.c.
+ * written); after the packing by joints (meshlets_pack.c), each underfull group, smallest first,
+ * is merged with the nearest underfull meshlet (in the Morton order of their first triangles, a
+ * window on each side) that fits together with it within every limit, the palette cap
+ * included. Every merge saves one meshlet and never adds a palette entry (the union of two
+ * palettes is at most their sum). The plan is then refined and written out by meshlets_refine.c.
  */
 #include "meshlets_internal.h"
 
@@ -60,6 +60,14 @@ void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan)
     sp_meshlet_reset_open(ctx);
 }
 
+void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a)
+{
+    plan->next[plan->tail[b]] = a;
+    plan->tail[b] = plan->tail[a];
+    plan->triangle_count[b] = (uint16_t)(plan->triangle_count[b] + plan->triangle_count[a]);
+    plan->merged[a] = 1;
+}
+
 /* Adds every triangle of the group that starts at meshlet m to the open meshlet; with
  * check, stops at the first that does not fit and returns 0. */
 static int add_group(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m, int check)
@@ -97,8 +105,8 @@ static size_t list_underfull(const sp_meshlet_context* ctx, sp_meshlet_plan* pla
 {
     size_t count = 0;
     for (uint32_t m = 0; m < plan->count; ++m)
-        if (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
-            plan->triangle_count[m] < ctx->options.max_triangles / 2)
+        if (!plan->merged[m] && (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
+                                 plan->triangle_count[m] < ctx->options.max_triangles / 2))
             plan->keys[count++] = (uint64_t)rank[plan->order[plan->start[m]]] << 32 | m;
     qsort(plan->keys, count, sizeof(uint64_t), compare_keys);
     for (size_t i = 0; i < count; ++i)
@@ -121,10 +129,7 @@ static void merge_into_neighbour(sp_meshlet_context* ctx, sp_meshlet_plan* plan,
             uint32_t b = plan->spatial[side == 0 ? at - d : at + d];
             if (plan->merged[b] || !groups_fit(ctx, plan, b, a))
                 continue;
-            plan->next[plan->tail[b]] = a; /* b's group absorbs a's */
-            plan->tail[b] = plan->tail[a];
-            plan->triangle_count[b] = (uint16_t)(plan->triangle_count[b] + plan->triangle_count[a]);
-            plan->merged[a] = 1;
+            sp_meshlet_plan_append(plan, b, a);
             return;
         }
 }

@@ -3,26 +3,28 @@
  * meshoptimizer (the count drives the cost of mesh-shader skinning), then few palette entries,
  * then few local tuple bits; the palette limit max_joints is a hard cap, never exceeded.
  *
- * Grows one meshlet at a time like meshopt_buildMeshlets (1.x): the next triangle is the best
- * live triangle adjacent to the meshlet's vertices that fits every limit. A candidate costs its
- * topological priority (topology_priority) plus joint_cost per joint it would add to the
- * palette and tuple_cost per tuple its new vertices would add to the local LUT; both default to
- * 0, because on the benchmark meshes even a joint tie-break (any joint_cost below one priority
- * step) costs a few meshlets against the distance tie-break; the palette cap is enforced either
- * way, and the refine step lowers the palette sum afterwards. Ties go to the
- * candidate nearest the centre of the meshlet's triangles, its distance scaled by
- * 1 + JOINT_DISTANCE_FACTOR per joint it would add: unlike a joint term in the cost, this keeps
- * the meshlets compact (no more meshlets on the benchmark meshes) and still steers growth along
- * the palette it has (0.1-1.2 % fewer palette entries than plain distance on the subdivided
- * benchmark meshes). When no adjacent triangle fits, the
- * meshlet closes, leaves seed candidates on its border, and the next meshlet starts at the
- * least enclosed seed (fewest free triangles around its corners, then nearest the mesh's low
- * corner), so meshlets sweep across the surface and leave no slivers behind. When the surface
- * patch runs out, the nearest free triangle (searched in a widening window of the Morton order
- * of triangle centroids, where meshoptimizer uses a k-d tree) continues it. Meshlets are
- * recorded as a plan and written at the end, after underfull ones are merged
- * (meshlets_merge.c) and border triangles moved where they cost fewer palette entries
- * (meshlets_refine.c) or traded between neighbours (meshlets_exchange.c).
+ * First, every connected part of the mesh that fits one meshlet whole is closed as one meshlet
+ * and left out of growth (meshlets_parts.c). The rest grows one meshlet at a time like
+ * meshopt_buildMeshlets (1.x): the next triangle is the best live triangle adjacent to the
+ * meshlet's vertices that fits every limit. A candidate costs its topological priority
+ * (topology_priority) plus joint_cost per joint it would add to the palette and tuple_cost per
+ * tuple its new vertices would add to the local LUT; both options default to 0, because on the
+ * benchmark meshes a joint term over the whole growth costs meshlets against the distance
+ * tie-break. Only in a meshlet's last max_vertices / LATE_VERTICES_DIVISOR vertices, where the
+ * vertex limit is about to close it anyway, does a new joint cost LATE_JOINT_COST on top: the
+ * meshlet then closes along the palette it has (0-4 % fewer palette entries on the benchmark
+ * meshes, no more meshlets). Ties go to the candidate nearest the centre of the meshlet's
+ * triangles, its distance scaled by 1 + JOINT_DISTANCE_FACTOR per joint it would add, which
+ * keeps the meshlets compact and still steers growth along the palette. When no adjacent
+ * triangle fits, the meshlet closes, leaves seed candidates on its border, and the next meshlet
+ * starts at the least enclosed seed (fewest free triangles around its corners, then nearest the
+ * mesh's low corner), so meshlets sweep across the surface and leave no slivers behind. When
+ * the surface patch runs out, the nearest free triangle (searched in a widening window of the
+ * Morton order of triangle centroids, where meshoptimizer uses a k-d tree) continues it.
+ * Meshlets are recorded as a plan and written at the end, after underfull ones are packed by
+ * their joints (meshlets_pack.c) and merged with near ones (meshlets_merge.c) and border
+ * triangles are moved where they cost fewer palette entries (meshlets_refine.c) or traded
+ * between neighbours (meshlets_exchange.c).
  */
 #include "meshlets_internal.h"
 
@@ -35,6 +37,8 @@
 #define PROXIMITY_WINDOW_MAX 2048 /* widened 8x at a time up to this */
 #define JUMP_JOINT_PENALTY 4.0f   /* distance factor per new joint (x joint_cost) for such jumps */
 #define JOINT_DISTANCE_FACTOR 1.0f /* tie-break: distance factor per joint a candidate adds to the palette */
+#define LATE_VERTICES_DIVISOR 7   /* the last max_vertices / 7 vertices of a meshlet are its "late" ones, */
+#define LATE_JOINT_COST 3.0f      /* where a new palette joint costs as much as 3 new vertices */
 #define SEEDS_PER_MESHLET 4       /* seed candidates a finished meshlet leaves on its border */
 #define SEED_POOL 256             /* seed candidates kept at most */
 
@@ -71,7 +75,10 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
                           sp_meshlet_align8(triangle_count * sizeof(uint32_t));      /* rank */
     size_t tuples = sp_meshlet_align8((tuple_slots + 1) * sizeof(uint32_t)) + /* tuple_stamp */
                     sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
-    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count);
+    size_t parts = sp_meshlet_parts_scratch_bound(triangle_count, vertex_count);
+    size_t pack = sp_meshlet_pack_scratch_bound(triangle_count); /* after the parts step, in the same bytes */
+    return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count) +
+           (parts > pack ? parts : pack);
 }
 
 /* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
@@ -357,6 +364,10 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
         return best;
     float point[3];
     open_centroid(ctx, s, point);
+    /* in the meshlet's last vertices a new joint also costs LATE_JOINT_COST (see the top) */
+    float joint_cost = ctx->options.joint_cost;
+    if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
+        joint_cost += LATE_JOINT_COST;
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
         uint32_t v = ctx->open_vertices[i];
         const uint32_t* list = s->adjacency + s->adjacency_offset[v];
@@ -372,7 +383,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
-            float cost = priority + ctx->options.joint_cost * (float)new_joints;
+            float cost = priority + joint_cost * (float)new_joints;
             if (ctx->options.tuple_cost > 0.0f)
                 cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
@@ -454,8 +465,9 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     build_spatial_order(ctx, &s);
+    size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
 
-    for (size_t done = 0; done < t_count; ++done) {
+    for (size_t done = packed; done < t_count; ++done) {
         if (ctx->open_triangle_count == 0) {
             emit(ctx, &s, next_seed(ctx, &s));
             continue;
@@ -489,9 +501,12 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
     }
     sp_meshlet_plan_close(ctx, &s.plan);
+    sp_meshlet_plan_pack(ctx, &s.plan, cursor);
     sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
     sp_meshlet_plan_link(&s.plan);
     sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
-    sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live); /* live: all 0, every triangle is out */
+    /* live as the exchange step's zeroed vertex scratch (the parts closed whole never left it) */
+    memset(s.live, 0, v_count * sizeof(uint32_t));
+    sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live);
     sp_meshlet_plan_write(ctx, &s.plan);
 }

@@ -142,13 +142,14 @@ static void random_tuples(void)
     free(w), free(codes);
 }
 
-/* N at and just past the largest the vector paths accept (exact there, scalar beyond), and
+/* N at and just past the largest the vector paths accept (exact there, scalar beyond), and the
+ * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024; double lanes beyond), and
  * codes at every layer and row start/end there, where the root estimates are off by one, and
  * the last codes, where the layer estimate's cube root argument is smallest. */
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}};
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}, {3, 8192}, {4, 1024}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -177,10 +178,12 @@ static void range_edges(void)
 /* Every layer's first and last codes (and their neighbours) for K = 4, every row's for K = 3,
  * from small budgets to the large ones: where the layer and row estimates are closest to
  * wrong (the AVX2 layer estimate's float cube root is good to ~1e-8, so its misses gather
- * there for large N), each lane decoded or redone as the scalar code decodes it. */
+ * there for large N; the 32-bit lanes' float roots, to 24 and 25 bits, miss more), each lane
+ * decoded or redone as the scalar code decodes it. */
 static void estimate_boundaries(void)
 {
-    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 32}, {4, 12}, {4, 22}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
+    static const struct { uint32_t k, bits; } cases[] = {{3, 12}, {3, 22}, {3, 24}, {3, 32}, {4, 12}, {4, 22},
+                                                          {4, 25}, {4, 32}, {4, 40}, {4, 44}, {4, 45}};
     for (size_t e = 0; e < sizeof(cases) / sizeof(cases[0]); ++e) {
         sp_codec c;
         uint32_t k = cases[e].k;
@@ -196,6 +199,21 @@ static void estimate_boundaries(void)
         compare_decode(&c, codes, count, "boundary decode");
         free(codes);
     }
+}
+
+/* Every weight q / s the 32-bit lanes compute (every q <= s = 2(N - 1) of every N they take,
+ * K = 3 up to 8192, K = 4 up to 1024): the first row of the first layer, codes 0..N - 1, holds
+ * q1 = 0..N - 1 and q0 = N - 1..s, so it reaches every q. */
+static void narrow_weights(void)
+{
+    uint64_t* codes = malloc(8192 * sizeof(uint64_t));
+    for (uint64_t v = 0; v < 8192; ++v) codes[v] = v;
+    for (uint32_t k = 3; k <= 4; ++k)
+        for (uint64_t n = 2; n <= (k == 3 ? 8192u : 1024u); ++n) {
+            sp_codec c = oss(k, n);
+            if (compare_decode(&c, codes, (size_t)n, "narrow weights")) break;
+        }
+    free(codes);
 }
 
 /* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero,
@@ -251,11 +269,13 @@ static void invalid_codes(void)
         sp_codec c;
         CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
         for (size_t at = 0; at < COUNT; ++at)
-            for (int pass = 0; pass < 2; ++pass) {
+            for (int pass = 0; pass < 3; ++pass) {
                 uint64_t codes[COUNT];
                 float w[COUNT * 4], ref[4];
+                /* just past the range, all ones, and a code whose low 32 bits are negative as int32 */
+                const uint64_t invalid[3] = {c.max_code + 1, UINT64_MAX, ((uint64_t)1 << 31) + 5};
                 for (size_t v = 0; v < COUNT; ++v) codes[v] = rng_next() % (c.max_code + 1);
-                codes[at] = pass ? UINT64_MAX : c.max_code + 1;
+                codes[at] = invalid[pass];
                 if (at + 3 < COUNT) codes[at + 3] = c.max_code + 7; /* a later one is not reported */
                 for (size_t i = 0; i < COUNT * 4; ++i) w[i] = -7.0f;
                 size_t bad = (size_t)-1;
@@ -325,6 +345,7 @@ int main(void)
         odd_weights();
         range_edges();
         estimate_boundaries();
+        narrow_weights();
         random_tuples();
     }
     return check_report("test_batch");

@@ -1,0 +1,28 @@
+/*
+ * The OSS batch paths for codes past the double lanes' exact range (internal): K = 3 past
+ * N = 2^24, K = 4 past N = 3 * 2^15 (every width up to 64 bits), K = 2 decode past N = 2^48 and
+ * its encode up to N = 2^49. The driver is codec_oss_wide_simd.h, the per-ISA files
+ * codec_oss_wide_avx2.c and codec_oss_wide_avx512.c; codec_oss_batch.c dispatches.
+ */
+#ifndef SKINPACK_CODEC_OSS_WIDE_H
+#define SKINPACK_CODEC_OSS_WIDE_H
+
+#include "codec_internal.h"
+
+/* Largest N of the K = 2 wide encode: its grid 2(N - 1) stays below 2^50, where sp_grid_quantize
+ * rounds in double (past it, in long double, which the vector lanes do not have). */
+#define SP_OSS_WIDE_MAX_N2_ENCODE ((uint64_t)1 << 49)
+
+/* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole
+ * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and
+ * sp_oss_decode_one; return how many leading vertices were done. Decode stops before a block
+ * holding a code above max_code. Call only where sp_cpu_isa() has the ISA and
+ * sp_oss_wide_encode_supported / sp_oss_wide_decode_supported (codec_oss_batch.c) allow it. */
+size_t sp_oss_wide_encode_avx2(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                               uint8_t* significant);
+size_t sp_oss_wide_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+size_t sp_oss_wide_encode_avx512(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                 uint8_t* significant);
+size_t sp_oss_wide_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+
+#endif

@@ -1,0 +1,363 @@
+/*
+ * The OSS block/chunk driver for wide codes, written once over per-ISA primitives (internal;
+ * included by codec_oss_wide_avx2.c and codec_oss_wide_avx512.c after the double-lane driver,
+ * codec_oss_simd.h, whose primitives, rounding and estimates it reuses).
+ *
+ * Past the double lanes' exact range (codec_oss_batch.c: layer and row bases past 2^50) the
+ * bases run in 64-bit integer lanes. Grid coordinates and codes fit 64 bits, and where an
+ * intermediate does not, the arithmetic is modulo 2^64 with a final value below 2^64:
+ *   - the row base s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4) as j (N - j) + floor((j + 1)^2 / 4),
+ *     since a floor by 4 does not commute with a reduction mod 2^64;
+ *   - the layer base u(k) = (a - r) / 9 with a its numerator mod 2^64, r = a mod 9 (which for a
+ *     given N depends only on k mod 3: a table of three in one word), and the exact division as
+ *     a product with 9's inverse mod 2^64.
+ * The root estimates stay in double lanes: their arguments (apex^2 + 3 - 12w for rows,
+ * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
+ * (wide_argument), so they are exact where small (near the apex, where a rounded code would
+ * cancel) and rounded once where large (where that moves the root by far less than a step). An
+ * estimate is then settled with exact compares; a lane that is still off (or whose rounding
+ * leaves the exact regime, as in codec_oss_simd.h) is redone by the scalar code.
+ *
+ * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN), on top of the
+ * double-lane primitives of codec_oss_simd.h:
+ *   uvec, umask        BLOCK unsigned 64-bit lanes and a lane mask
+ *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates), u_srlv
+ *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
+ *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
+ *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_select(m, a, b) = m ? a : b, um_bits (lanes as bits)
+ *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
+ *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
+ *   in [0, 2^52))
+ *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
+ *                      store_weights for K = 2 and 3
+ *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
+ * and WIDE_NAME(name), the entry points' names.
+ */
+
+/* 9 u mod 2^64 -> u: 9 * INVERSE_OF_9 = 1 mod 2^64. */
+#define INVERSE_OF_9 0x8E38E38E38E38E39ull
+
+/* The per-codec constants of the wide lanes (mod 2^64 where marked). */
+typedef struct wide_codec {
+    double n, scale;          /* N and the grid 2(N - 1), rounded for K = 2 */
+    uint64_t n_bits, scale_bits;
+    double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
+    double apex, last_row, last_layer;
+    uint64_t rows;            /* (2N + 1) / 3 (K = 3) */
+    uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
+    uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
+    double root_high, root_low;  /* 8M^3 + 12M^2 - 106 (M = N + 1) as two exact doubles (K = 4) */
+} wide_codec;
+
+/* a < 2^73 as high + low, both exact doubles: high = a with its low 20 bits cleared (at most 53
+ * significant bits), low = those 20 bits. */
+static void split_exactly(sp_u128 a, double* high, double* low)
+{
+    uint64_t top = (sp_u128_high(a) << 44) | (sp_u128_low(a) >> 20);
+    *high = (double)top * 0x1p20;
+    *low = (double)(sp_u128_low(a) & 0xFFFFF);
+}
+
+static wide_codec wide_codec_for(const sp_codec* codec)
+{
+    uint64_t n = codec->n, m = n + 1, apex = 2 * n + 1; /* wraps for K = 2 past 2^63: unused there */
+    wide_codec c;
+    c.n = (double)n, c.scale = (double)codec->scale, c.n_bits = n, c.scale_bits = codec->scale;
+    sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(apex), sp_u128_from(apex)), 3);
+    split_exactly(square, &c.mirrored_high, &c.mirrored_low);
+    c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
+    c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1), c.last_layer = (double)((n + 1) / 2 - 1);
+    c.rows = (2 * n + 1) / 3;
+    c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
+    sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
+    sp_u128 root = sp_u128_sub(sp_u128_add(sp_u128_mul_u64(sp_u128_mul_u64(m2, m), 8), sp_u128_mul_u64(m2, 12)),
+                               sp_u128_from(106));
+    split_exactly(root, &c.root_high, &c.root_low);
+    /* 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 mod 9 with N mod 9 and k mod 3 for N and k: the first
+     * term is 3 times something taken mod 3, the second 4k^3 + 6k mod 9, and (k + 3)^3 = k^3 mod 9. */
+    int64_t nm = (int64_t)(n % 9);
+    c.layer_remainders = 0;
+    for (int64_t k = 0; k < 3; ++k) {
+        int64_t a = 3 * nm * k * (nm - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2;
+        c.layer_remainders |= (uint64_t)(((a % 9) + 9) % 9) << (4 * k);
+    }
+    return c;
+}
+
+/* s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4), K = 3: the numerator is 4 j (N - j) + (j + 1)^2, so
+ * s_N(j) = j (N - j) + floor((j + 1)^2 / 4) = j (N - j) + floor((j + 1) / 2) ceil((j + 1) / 2),
+ * below 2^64 inside the triangle: a product mod 2^64 (no floor of a wrapped value) and one of
+ * two halves below 2^32. */
+SP_INLINE SIMD_FN uvec wide_row_base(const wide_codec* c, uvec j)
+{
+    uvec one = u_splat(1), half = u_srl(u_add(j, one), 1), half_up = u_srl(u_add(j, u_splat(2)), 1);
+    return u_add(u_mul(j, u_sub(u_splat(c->n_bits), j)), u_mul32(half, half_up));
+}
+
+/* Codes in row j, floor((2N - 3j) / 2) = N - j - (j + 1) / 2 (at least 1 for rows j < rows). */
+SP_INLINE SIMD_FN uvec wide_row_length(const wide_codec* c, uvec j)
+{
+    return u_sub(u_sub(u_splat(c->n_bits), j), u_srl(u_add(j, u_splat(1)), 1));
+}
+
+/* u(k) = floor(a / 9), a = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 (Horner, mod 2^64), for layers
+ * k < 2^32: (a - a mod 9) times 9's inverse. k mod 3 from floor(k / 3) = k 0xAAAAAAAB / 2^33. */
+SP_INLINE SIMD_FN uvec wide_layer_base(const wide_codec* c, uvec k)
+{
+    uvec third = u_srl(u_mul32(k, u_splat(0xAAAAAAABu)), 33);
+    uvec k_mod3 = u_sub(k, u_add(third, u_add(third, third)));
+    uvec r = u_and(u_srlv(u_splat(c->layer_remainders), u_sll(k_mod3, 2)), u_splat(15));
+    uvec a = u_sub(u_sll(k, 2), u_splat(c->layer_c1));
+    a = u_add(u_mul_u32(a, k), u_splat(c->layer_c0));
+    a = u_add(u_mul_u32(a, k), u_splat(2));
+    return u_mul(u_sub(a, r), u_splat(INVERSE_OF_9));
+}
+
+/* Codes in layer k, u(k + 1) - u(k) = (b^2 + b + 1) / 3 with b = N - 2k < 2^23, as
+ * floor((b (b + 1) + 3/2) / 3): exact below 2^50, and the quotient lies at least 1/6 from an
+ * integer, far more than the product with the rounded 1/3 is off. */
+SP_INLINE SIMD_FN vec wide_layer_length(double n, vec k)
+{
+    vec b = v_fnmadd(k, v_splat(2.0), v_splat(n));
+    return v_floor(v_mul(v_fmadd(b, v_add(b, v_splat(1.0)), v_splat(1.5)), v_splat(1.0 / 3.0)));
+}
+
+/* high + low - factor a for a code a (factor 12 or 144, high + low < 2^73 from split_exactly):
+ * with a = 2^32 ah + al, high - (factor 2^32) ah is exact (a multiple of 2^20 below 2^73), the
+ * rest rounds only where the sum is past 2^53. So exact for small results, where the roots'
+ * arguments cancel, and within 2^-52 of it otherwise. */
+SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec a)
+{
+    vec a_high, a_low;
+    v_halves(a, &a_high, &a_low);
+    vec top = v_add(v_fnmadd(a_high, v_splat(factor * 0x1p32), v_splat(high)), v_splat(low));
+    return v_fnmadd(a_low, v_splat(factor), top);
+}
+
+/* ---- encode ----------------------------------------------------------------------------- */
+
+/* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
+ * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h. */
+SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
+{
+    if (k == 2) return u_from_v(q[1]);
+    if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
+    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n));
+    vec in_layer = v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2]));
+    return u_add(wide_layer_base(c, u_from_v(q[3])), u_from_v(in_layer));
+}
+
+/* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
+ * as bits (the grids here are below 2^50, where sp_grid_quantize rounds in double, so
+ * codec_oss_simd.h's rounding is exact). */
+SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, unsigned ordered, uint32_t k,
+                                             uint64_t* codes, uint8_t* significant)
+{
+    vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
+    vec deficit = quantize_floor(w, k, c->scale, scale, q, remainder);
+    unsigned missed = round_block(k, deficit, remainder, q, ordered);
+    u_store(codes, wide_pack(c, q, k));
+    if (significant) store_significant(q, k, significant);
+    return missed;
+}
+
+/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
+ * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
+ * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes. */
+SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec* c, const float* weights,
+                                         size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
+                                         const simd_layout* layout)
+{
+    vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
+    for (size_t b = 0; b < blocks; ++b) {
+        load_weights(weights + b * BLOCK * k, k, layout, w[b]);
+        scale[b] = quantize_scale(w[b], k, c->scale);
+        ordered[b] = weights_ordered(w[b], k);
+    }
+    if (ENCODE_FUSED)
+        for (size_t b = 0; b < blocks; ++b)
+            missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+    else {
+        vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
+        vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
+        for (size_t b = 0; b < blocks; ++b) {
+            deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
+            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
+        }
+        for (size_t b = 0; b < blocks; ++b) {
+            u_store(codes + b * BLOCK, wide_pack(c, q[b], k));
+            if (significant) store_significant(q[b], k, significant + b * BLOCK);
+        }
+    }
+    for (size_t b = 0; b < blocks; ++b)
+        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
+}
+
+SP_INLINE SIMD_FN size_t wide_encode_blocks(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                            uint8_t* significant, uint32_t k)
+{
+    simd_layout layout = layout_for(k);
+    wide_codec c = wide_codec_for(codec);
+    size_t v = 0;
+    while (v + BLOCK <= count) {
+        size_t blocks = (count - v) / BLOCK;
+        if (blocks > ENCODE_CHUNK) blocks = ENCODE_CHUNK;
+        wide_encode_chunk(codec, &c, weights + v * k, blocks, codes + v, significant ? significant + v : NULL, k, &layout);
+        v += blocks * BLOCK;
+    }
+    return v;
+}
+
+SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                 uint8_t* significant)
+{
+    switch (codec->influences) { /* constant k: unrolled lanes */
+    case 2: return wide_encode_blocks(codec, weights, count, codes, significant, 2);
+    case 3: return wide_encode_blocks(codec, weights, count, codes, significant, 3);
+    default: return wide_encode_blocks(codec, weights, count, codes, significant, 4);
+    }
+}
+
+/* ---- decode ----------------------------------------------------------------------------- */
+
+/*
+ * The estimates here are taken half a row or layer low: the rounded roots are off by far less
+ * than half a step (K = 3: ~1e-5 of a row, from the argument's and the square root's rounding at
+ * 2^-52 of values up to 2^34; K = 4: AVX-512's root and AVX2's after its Newton step, no lane of
+ * the tests' tens of millions missed), so floored, an estimate is the step or the one before it,
+ * and one compare going up settles it. Lanes it does not settle fail the exact checks, whatever
+ * the estimate was (checked with estimates biased by two steps and more), and are redone.
+ */
+
+/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
+ * root's argument apex^2 + 3 - 12(w + 7/8) from wide_argument), half a row low, floored and
+ * clamped to the rows. */
+SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, uvec w)
+{
+    vec mirrored = wide_argument(c->mirrored_high, c->mirrored_low, 12.0, w);
+    vec root = v_sqrt(v_max(mirrored, v_zero()));
+    return clamp_floor(v_fmsub(v_sub(v_splat(c->apex), root), v_splat(1.0 / 3.0), v_splat(0.5)), v_splat(c->last_row));
+}
+
+/* K = 3: the row j of code w from its estimate (j or j - 1), and i = w - s_N(j), into q; returns
+ * the lanes whose (j, i) is not proven right (i outside row j, or j past the last row, whose
+ * length formula wraps: a step up from the last row, which only an estimate off by more than the
+ * bound takes), as bits. */
+SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, uvec w, vec estimate, vec* q)
+{
+    uvec j = u_from_v(estimate), length = wide_row_length(c, j), i = u_sub(w, wide_row_base(c, j));
+    umask above = u_lt(u_sub(length, u_splat(1)), i); /* i >= length: the next row */
+    j = u_select(above, u_add(j, u_splat(1)), j);
+    i = u_select(above, u_sub(i, length), i);
+    unsigned ok = um_bits(u_lt(i, wide_row_length(c, j))) & um_bits(u_lt_small(j, u_splat(c->rows))); /* i < 0 wraps */
+    unpacked_block(c->n, 3, v_zero(), v_from_u(j), v_from_u(i), q);
+    return ~ok & ((1u << BLOCK) - 1);
+}
+
+/* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
+SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, uvec code)
+{
+    return wide_argument(c->root_high, c->root_low, 144.0, code);
+}
+
+/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate), half a layer low, from its
+ * root t of t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the
+ * widest codes (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic
+ * first (its cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
+SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
+{
+    if (WIDE_ROOT_NEWTON) {
+        vec square = v_mul(t, t);
+        vec excess = v_fmsub(t, v_sub(square, v_splat(3.0)), x);
+        t = v_sub(t, v_div(excess, v_fmsub(square, v_splat(3.0), v_splat(3.0))));
+    }
+    return clamp_floor(v_fnmadd(t, v_splat(0.25), v_splat((2 * c->n + 3) / 4 - 0.5)), v_splat(c->last_layer));
+}
+
+/* K = 4: rest = code - u(k) for the estimated layer k (k or k - 1), one step up, in double
+ * lanes: exact below 2^52, and a rest past that (a layer estimate off by more than the bound, or
+ * a negative rest, which wraps) stays past every layer's codes, rounded as it may be. The row
+ * check then proves the layer: it accepts only a rest inside the layer's triangle. */
+SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, uvec code, vec* layer)
+{
+    vec rest = v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(*layer))));
+    vec length = wide_layer_length(c->n, *layer);
+    mask above = m_ge(rest, length);
+    *layer = v_add_where(*layer, above, v_splat(1.0));
+    return v_sub(rest, v_add_where(v_zero(), above, length));
+}
+
+/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes <= max_code, in stages as in
+ * codec_oss_simd.h (K = 4: the layer root's two halves, the layer and the row estimate, the rest;
+ * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed. */
+SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec* c, const uint64_t* codes,
+                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
+{
+    double inverse = 1.0 / (double)codec->scale;
+    vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
+    root z[DECODE_CHUNK];
+    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    if (k == 4) {
+        for (size_t b = 0; b < blocks; ++b) {
+            x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
+            z[b] = root_start(x[b]);
+        }
+        for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
+        for (size_t b = 0; b < blocks; ++b) {
+            rest[b] = wide_settle_layer(c, u_load(codes + b * BLOCK), &layer[b]);
+            bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
+        }
+        for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */
+    }
+    if (k == 3)
+        for (size_t b = 0; b < blocks; ++b) row[b] = wide_row_estimate(c, u_load(codes + b * BLOCK));
+    for (size_t b = 0; b < blocks; ++b) {
+        vec q[SP_MAX_INFLUENCES];
+        uvec code = u_load(codes + b * BLOCK);
+        float* out = weights + b * BLOCK * k;
+        missed[b] = 0;
+        if (k == 2) { /* no grid vectors to build */
+            store_pairs(v_from_u_rounded(u_sub(u_splat(c->scale_bits), code)), v_from_u_rounded(code), inverse, layout, out);
+        } else if (k == 3) {
+            missed[b] = wide_unpack_rows(c, code, row[b], q);
+            store_triples(q, inverse, layout, out);
+        } else {
+            mask ok;
+            vec i = row_offset(bottom[b], row[b], rest[b], &ok);
+            unpacked_block(c->n, 4, layer[b], row[b], i, q);
+            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
+            store_weights(q, 4, inverse, layout, out);
+        }
+    }
+    for (size_t b = 0; b < blocks; ++b)
+        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
+            if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+}
+
+SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                            uint32_t k)
+{
+    simd_layout layout = layout_for(k);
+    wide_codec c = wide_codec_for(codec);
+    size_t v = 0;
+    while (v + BLOCK <= count) {
+        size_t blocks = (count - v) / BLOCK, valid = 0;
+        if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
+        while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
+        if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
+        wide_decode_chunk(codec, &c, codes + v, valid, weights + v * k, k, &layout);
+        v += valid * BLOCK;
+    }
+    return v;
+}
+
+SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
+{
+    switch (codec->influences) {
+    case 2: return wide_decode_blocks(codec, codes, count, weights, 2);
+    case 3: return wide_decode_blocks(codec, codes, count, weights, 3);
+    default: return wide_decode_blocks(codec, codes, count, weights, 4);
+    }
+}

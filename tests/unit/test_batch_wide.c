@@ -1,0 +1,282 @@
+/*
+ * The wide OSS vector paths (codec_oss_wide_simd.h: 64-bit integer lanes for K = 3 past
+ * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 decode past N = 2^48) against the scalar code, bit
+ * for bit, once per vector path the CPU has: codes around every layer start (K = 4) and around
+ * row starts (every row of sampled layers; for K = 3 every row just past the double lanes, and
+ * the first, last and sampled rows of wider codes, where the root arguments stop being exact),
+ * the last codes, random codes and weights from 46 to 64 bits, odd weights, counts and
+ * alignments, and invalid codes, which stop the batch where the scalar code stops.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../native/src/codec_internal.h" /* the *_isa batch forms: one path at a time */
+#include "check.h"
+#include "skinpack.h"
+
+static sp_isa widest = SP_ISA_AVX512;
+
+static sp_codec oss_bits(uint32_t k, uint32_t bits)
+{
+    sp_codec c;
+    CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, bits, &c) == SP_OK);
+    return c;
+}
+
+static sp_codec oss_n(uint32_t k, uint64_t n)
+{
+    sp_codec c;
+    CHECK(sp_codec_from_params(SP_METHOD_OSS, k, n, NULL, &c) == SP_OK);
+    return c;
+}
+
+/* Decodes codes with the vector path under test and with the scalar path only (the reference,
+ * spot-checked against sp_decode_weights), comparing the floats bit for bit. */
+static void compare_decode(const sp_codec* c, const uint64_t* codes, size_t count, const char* what)
+{
+    uint32_t k = c->influences;
+    float* w = malloc((count * k + 1) * sizeof(float));
+    float* ref = malloc((count * k + 1) * sizeof(float));
+    float one[SP_MAX_INFLUENCES];
+    int before = check_failures;
+    CHECK(sp_decode_weights_batch_isa(c, codes, count, w, NULL, widest) == SP_OK);
+    CHECK(sp_decode_weights_batch_isa(c, codes, count, ref, NULL, SP_ISA_SCALAR) == SP_OK);
+    for (size_t v = 0; v < count && check_failures - before < 5; ++v) {
+        CHECK_MSG(memcmp(w + v * k, ref + v * k, k * sizeof(float)) == 0, "%s K=%u N=%llu code %llu: %.9g %.9g vs %.9g %.9g",
+                  what, k, (unsigned long long)c->n, (unsigned long long)codes[v], w[v * k], w[v * k + 1], ref[v * k],
+                  ref[v * k + 1]);
+        if (v % 997 == 0) {
+            sp_decode_weights(c, codes[v], one);
+            CHECK(memcmp(one, ref + v * k, k * sizeof(float)) == 0);
+        }
+    }
+    free(w), free(ref);
+}
+
+/* Encodes with the vector path under test and vertex by vertex (one-vertex batches are scalar):
+ * codes and significant counts, also without the counts. */
+static void compare_encode(const sp_codec* c, const float* w, size_t count, const char* what)
+{
+    uint32_t k = c->influences;
+    uint64_t* codes = malloc((count + 1) * sizeof(uint64_t));
+    uint64_t* bare = malloc((count + 1) * sizeof(uint64_t));
+    uint8_t* sig = malloc(count + 1);
+    int before = check_failures;
+    CHECK(sp_encode_weights_batch_isa(c, w, count, codes, sig, widest) == SP_OK);
+    CHECK(sp_encode_weights_batch_isa(c, w, count, bare, NULL, widest) == SP_OK);
+    for (size_t v = 0; v < count && check_failures - before < 5; ++v) {
+        uint64_t ref;
+        uint8_t ref_sig;
+        CHECK(sp_encode_weights_batch_isa(c, w + v * k, 1, &ref, &ref_sig, SP_ISA_SCALAR) == SP_OK);
+        CHECK_MSG(codes[v] == ref && bare[v] == ref && sig[v] == ref_sig, "%s K=%u N=%llu vertex %zu: %llu vs %llu",
+                  what, k, (unsigned long long)c->n, v, (unsigned long long)codes[v], (unsigned long long)ref);
+    }
+    free(codes), free(bare), free(sig);
+}
+
+/* The codes start - 2 .. start + 1 of a base, those in range. */
+static size_t push_around(const sp_codec* c, uint64_t start, uint64_t* codes, size_t count)
+{
+    for (uint64_t d = 0; d < 4; ++d)
+        if (start + d >= 2 && start + d - 2 <= c->max_code) codes[count++] = start + d - 2;
+    return count;
+}
+
+/* K = 3 rows (first, last, random, and around the rows where the root argument apex^2 + 3 - 12w
+ * crosses 2^62) or the rows of one K = 4 layer (all of them when `every`). */
+static size_t push_rows(const sp_codec* c, uint64_t base, uint64_t bottom, int every, uint64_t* codes, size_t count)
+{
+    uint64_t rows = (2 * bottom + 1) / 3, apex = 2 * bottom + 1, cross = apex > 0x80000000ull ? (apex - 0x80000000ull) / 3 : 0;
+    if (every)
+        for (uint64_t j = 0; j <= rows; ++j) count = push_around(c, base + sp_oss_row_base(bottom, j), codes, count);
+    else
+        for (uint64_t s = 0; s < 6000; ++s) {
+            uint64_t j = s < 1000 ? s : s < 2000 ? rows - (s - 1000) : s < 3000 ? cross + s - 2500 : rng_next() % rows;
+            if (j <= rows) count = push_around(c, base + sp_oss_row_base(bottom, j), codes, count);
+        }
+    return count;
+}
+
+/* Codes around every layer start of K = 4 (and every row of a few layers), around sampled row
+ * starts of K = 3, around powers of two for K = 2, and the last 64 codes. */
+static void boundaries(const sp_codec* c)
+{
+    uint64_t n = c->n, layers = c->influences == 4 ? (n + 1) / 2 : 1;
+    size_t cap = (size_t)layers * 4 + 6000 * 4 * 8 + 64 + (c->influences == 4 && n < 200000 ? 8 * n : 0);
+    uint64_t* codes = malloc(cap * sizeof(uint64_t));
+    size_t count = 0;
+    if (c->influences == 4) {
+        for (uint64_t k = 0; k <= layers; ++k) count = push_around(c, sp_oss_layer_base(n, k), codes, count);
+        uint64_t sampled[] = {0, 1, layers / 3, layers - 2, rng_next() % layers};
+        for (size_t s = 0; s < 5; ++s)
+            count = push_rows(c, sp_oss_layer_base(n, sampled[s]), n - 2 * sampled[s], n < 200000 && s == 2, codes, count);
+    } else if (c->influences == 3) {
+        count = push_rows(c, 0, n, 0, codes, count);
+    } else { /* K = 2: around the powers of two, where the conversions to double start rounding */
+        for (uint32_t bit = 1; bit < 64; ++bit) count = push_around(c, (uint64_t)1 << bit, codes, count);
+        for (uint32_t bit = 1; bit < 64; ++bit) count = push_around(c, c->scale - ((uint64_t)1 << bit), codes, count);
+    }
+    for (uint64_t d = 0; d < 64; ++d) codes[count++] = c->max_code - d;
+    compare_decode(c, codes, count, "boundary decode");
+    free(codes);
+}
+
+/* K = 3 just past the double lanes (N = 2^24 + 1): codes around every row start, in batches. */
+static void every_row_start(void)
+{
+    sp_codec c = oss_n(3, ((uint64_t)1 << 24) + 1);
+    uint64_t rows = (2 * c.n + 1) / 3, batch = 1 << 18;
+    uint64_t* codes = malloc(batch * 4 * sizeof(uint64_t));
+    for (uint64_t first = 0; first <= rows; first += batch) {
+        size_t count = 0;
+        for (uint64_t j = first; j < first + batch && j <= rows; ++j) count = push_around(&c, sp_oss_row_base(c.n, j), codes, count);
+        compare_decode(&c, codes, count, "row start decode");
+    }
+    free(codes);
+}
+
+/* Random sorted weights of several shapes (ties, zeros, one-hot), some off by a float step. */
+static void random_weights(uint32_t k, float* w)
+{
+    double raw[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, sum = 0;
+    uint64_t shape = rng_next() % 6;
+    for (uint32_t i = 0; i < k; ++i) raw[i] = shape == 3 && i > 0 ? 0 : rng_unit();
+    if (shape == 1) raw[1] = raw[0];
+    if (shape == 2) raw[k - 1] = 0;
+    for (uint32_t i = 1; i < k; ++i)
+        for (uint32_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
+            double t = raw[j];
+            raw[j] = raw[j - 1], raw[j - 1] = t;
+        }
+    for (uint32_t i = 0; i < k; ++i) sum += raw[i];
+    for (uint32_t i = 0; i < k; ++i) w[i] = (float)(raw[i] / sum);
+    if (shape == 4) w[rng_next() % k] = nextafterf(w[0], 1.0f); /* maybe unsorted */
+}
+
+/* Random codes, their decoded weights re-encoded (grid points) and nudged by a float step, and
+ * random weights. */
+static void random_round_trips(const sp_codec* c)
+{
+    uint32_t k = c->influences;
+    size_t count = 100000;
+    uint64_t* codes = malloc(count * sizeof(uint64_t));
+    float* w = malloc(count * k * sizeof(float));
+    for (size_t v = 0; v < count; ++v) codes[v] = c->max_code == UINT64_MAX ? rng_next() : rng_next() % (c->max_code + 1);
+    compare_decode(c, codes, count, "random decode");
+    CHECK(sp_decode_weights_batch_isa(c, codes, count, w, NULL, SP_ISA_SCALAR) == SP_OK);
+    compare_encode(c, w, count, "decoded encode");
+    for (size_t i = 0; i < count * k; ++i) w[i] = nextafterf(w[i], (i & 1) ? 0.0f : 1.0f);
+    compare_encode(c, w, count, "nudged encode");
+    for (size_t v = 0; v < count; ++v) random_weights(k, w + v * k);
+    compare_encode(c, w, count, "random encode");
+    free(codes), free(w);
+}
+
+/* An invalid code anywhere in a batch: the first one is reported, every vertex before it is
+ * decoded as the scalar path decodes it, and none after it is written. */
+static void invalid_codes(const sp_codec* c)
+{
+    enum { COUNT = 44 }; /* past an AVX-512 chunk, into blocks of 8 and 4 */
+    uint32_t k = c->influences;
+    if (c->max_code == UINT64_MAX) return; /* every code is valid */
+    for (size_t at = 0; at < COUNT; ++at) {
+        uint64_t codes[COUNT];
+        float w[COUNT * 4], ref[COUNT * 4];
+        for (size_t v = 0; v < COUNT; ++v) codes[v] = rng_next() % (c->max_code + 1);
+        codes[at] = at % 2 ? UINT64_MAX : c->max_code + 1;
+        if (at + 3 < COUNT) codes[at + 3] = c->max_code + 7; /* a later one is not reported */
+        for (size_t i = 0; i < COUNT * 4; ++i) w[i] = ref[i] = -7.0f;
+        size_t bad = (size_t)-1, ref_bad = (size_t)-2;
+        CHECK(sp_decode_weights_batch_isa(c, codes, COUNT, w, &bad, widest) == SP_ERR_CODE_OUT_OF_RANGE);
+        CHECK(sp_decode_weights_batch_isa(c, codes, COUNT, ref, &ref_bad, SP_ISA_SCALAR) == SP_ERR_CODE_OUT_OF_RANGE);
+        CHECK_MSG(bad == at && ref_bad == at, "K=%u invalid at %zu reported at %zu", k, at, bad);
+        CHECK(memcmp(w, ref, sizeof(w)) == 0); /* the same decoded prefix, the same untouched rest */
+    }
+}
+
+/* The vertices the vector paths take in a batch of 23 (the scalar loop does the rest): a path
+ * that silently did nothing would pass every comparison above. */
+static void path_coverage(const sp_codec* c, int encodes)
+{
+    float w[23 * 4];
+    uint64_t codes[23];
+    sp_isa cpu = sp_cpu_isa();
+    size_t expected = cpu >= SP_ISA_AVX2 ? 20 : 0; /* AVX-512: two blocks of 8 and one of 4 */
+    for (size_t v = 0; v < 23; ++v) random_weights(c->influences, w + v * c->influences);
+    CHECK_MSG(sp_oss_encode_batch(c, w, 23, codes, NULL, widest) == (encodes ? expected : 0), "K=%u N=%llu encode prefix",
+              c->influences, (unsigned long long)c->n);
+    for (size_t v = 0; v < 23; ++v) codes[v] = rng_next() % (c->max_code + 1);
+    CHECK_MSG(sp_oss_decode_batch(c, codes, 23, w, widest) == expected, "K=%u N=%llu decode prefix", c->influences,
+              (unsigned long long)c->n);
+    CHECK(sp_oss_batch_supported(c) == encodes);
+}
+
+/* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero, not
+ * summing to 1): the vector lanes must hand them to the scalar code. */
+static void odd_weights(const sp_codec* c)
+{
+    static const float odd[] = {-1e-3f, -0.0f, 0.0f, NAN, INFINITY, -INFINITY, 0.5f, 2.0f, 1.0f, 0.75f};
+    uint32_t k = c->influences;
+    size_t count = 4000;
+    float* w = malloc(count * k * sizeof(float));
+    for (size_t v = 0; v < count; ++v) {
+        random_weights(k, w + v * k);
+        for (uint32_t i = 0; i < k; ++i)
+            if (rng_next() % 4 == 0) w[v * k + i] = odd[rng_next() % (sizeof(odd) / sizeof(odd[0]))];
+    }
+    compare_encode(c, w, count, "odd encode");
+    free(w);
+}
+
+/* Counts around the block sizes (chunks, blocks of 8 and 4, tails) and pointers off the
+ * vectors' alignment; a zero count with null pointers is fine. */
+static void counts_and_alignment(const sp_codec* c)
+{
+    float w[4 * 72 + 4];
+    uint64_t codes[72 + 2];
+    uint32_t k = c->influences;
+    for (size_t offset = 0; offset < 3; ++offset)
+        for (size_t count = 0; count <= 70; count += 1 + count / 8) {
+            for (size_t v = 0; v < count; ++v) random_weights(k, w + offset + v * k);
+            compare_encode(c, w + offset, count, "count encode");
+            for (size_t v = 0; v < count; ++v) codes[offset + v] = rng_next() % (c->max_code + 1);
+            compare_decode(c, codes + offset, count, "count decode");
+        }
+    CHECK(sp_encode_weights_batch_isa(c, NULL, 0, NULL, NULL, widest) == SP_OK);
+    CHECK(sp_decode_weights_batch_isa(c, NULL, 0, NULL, NULL, widest) == SP_OK);
+}
+
+static void check_codec(const sp_codec* c, int encodes)
+{
+    counts_and_alignment(c);
+    odd_weights(c);
+    path_coverage(c, encodes);
+    boundaries(c);
+    random_round_trips(c);
+    invalid_codes(c);
+}
+
+int main(void)
+{
+    static const uint32_t widths[] = {46, 48, 52, 56, 60, 64};
+    static const sp_isa paths[] = {SP_ISA_AVX512, SP_ISA_AVX2};
+    for (size_t p = 0; p < sizeof(paths) / sizeof(paths[0]); ++p) {
+        widest = paths[p];
+        for (uint32_t k = 3; k <= 4; ++k)
+            for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
+                sp_codec c = oss_bits(k, widths[i]);
+                if (c.n > (k == 3 ? (uint64_t)1 << 24 : (uint64_t)3 << 15)) check_codec(&c, 1);
+            }
+        /* just past the double lanes, and the largest N of each K */
+        sp_codec edges[] = {oss_n(3, ((uint64_t)1 << 24) + 1), oss_n(4, ((uint64_t)3 << 15) + 1),
+                            oss_n(2, ((uint64_t)1 << 48) + 1), oss_n(2, (uint64_t)1 << 49)};
+        for (size_t e = 0; e < sizeof(edges) / sizeof(edges[0]); ++e) check_codec(&edges[e], 1);
+        sp_codec k2_52 = oss_bits(2, 52), k2_64 = oss_bits(2, 64), k2_past = oss_n(2, ((uint64_t)1 << 49) + 1);
+        check_codec(&k2_52, 0); /* K = 2 encode past 2^49 rounds in long double: scalar */
+        check_codec(&k2_64, 0);
+        check_codec(&k2_past, 0);
+        every_row_start();
+    }
+    return check_report("test_batch_wide");
+}
