@@ -2,6 +2,8 @@
 #ifndef SKINPACK_CODEC_INTERNAL_H
 #define SKINPACK_CODEC_INTERNAL_H
 
+#include <string.h> /* memcpy */
+
 #include "skinpack.h"
 
 #include "cpu_features.h"
@@ -28,43 +30,143 @@ SP_INLINE double sp_positive_or_zero(double x)
 #endif
 }
 
+/* Grids below this size take the double-precision rounding (sp_grid_round); larger ones the
+ * exact K = 2 rounding (sp_grid_round_pair; no grid of K = 3, 4 codes is this large) or, for odd
+ * input, the long double one of sp_grid_quantize_general. */
+#define SP_GRID_DOUBLE_LIMIT ((uint64_t)1 << 50)
+
+/* s / (the sum of the k weights), the grid scale of one vertex: its own step, so that a batch
+ * can run the divisions of several vertices before their roundings (the division ends a long
+ * chain). The sum starts at weights[0], not 0 + weights[0]: they differ only when every weight
+ * is -0, where the scale is -inf instead of +inf and every product 0 * inf is NaN either way. */
+SP_INLINE double sp_grid_scale(const float* weights, uint32_t k, double s)
+{
+    double sum = weights[0];
+    SP_UNROLL for (uint32_t i = 1; i < k; ++i) sum += weights[i];
+    return s / sum;
+}
+
 /*
- * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s.
- * Inlined so that callers with a constant k get unrolled, branch-free code: for grids below
- * 2^50 (double is exact enough) floor by conversion, then add one to the d largest remainders
- * chosen by rank instead of by sorting.
+ * Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s,
+ * for grids s < SP_GRID_DOUBLE_LIMIT (double is exact enough) and scale = sp_grid_scale: floor
+ * by conversion, then add one to the d largest remainders chosen by rank instead of by sorting.
+ * Returns 0, q undefined, where the deficit d is not in [0, k) (degenerate input): the general
+ * rounding decides those. Inlined so that callers with a constant k get unrolled, branch-free
+ * code with q in registers.
  */
+SP_INLINE int sp_grid_round(const float* weights, uint32_t k, uint64_t s, double scale, uint64_t* q)
+{
+    k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES;
+    double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    uint64_t deficit = s;
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
+        double x = weights[i] * scale;
+        x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
+        x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
+        int64_t f = (int64_t)x;
+        q[i] = (uint64_t)f;
+        remainder[i] = x - (double)f;
+        deficit -= (uint64_t)f; /* s < 2^50 and each f <= s: wraps only below zero */
+    }
+    if (deficit >= k) return 0;
+    /* rank[i]: components that win the bump before i (larger, or equal and lower); each pair
+     * is compared once, a < b wins when its remainder is not smaller. */
+    uint64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) rank[i] = k - 1 - i; /* every later slot, unless i wins */
+    SP_UNROLL for (uint32_t a = 0; a < k; ++a)
+        SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
+            uint64_t a_wins = remainder[a] >= remainder[b];
+            rank[b] += a_wins;
+            rank[a] -= a_wins;
+        }
+    SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += rank[i] < deficit;
+    return 1;
+}
+
+/*
+ * The two weights of a K = 2 rounding as exact integers: the smaller one is small 2^e, the
+ * larger large 2^(e + gap), with 24-bit significands (a denormal's exponent is the smallest
+ * normal one's). The smaller is slot 1 where the two are equal; ties_up is 1 where it is slot 0
+ * (the tie rule gives a tie to slot 0, so that slot's x rounds half up, slot 1's half down).
+ * plain: both finite and >= 0 (-0 counts as 0) and not both zero; the rest is the general
+ * rounding's (odd input keeps its results).
+ */
+typedef struct sp_grid_pair {
+    uint64_t small, large;
+    uint32_t gap, ties_up, plain;
+} sp_grid_pair;
+
+SP_INLINE sp_grid_pair sp_grid_pair_parts(const float* weights)
+{
+    uint32_t bits0, bits1;
+    memcpy(&bits0, &weights[0], sizeof(bits0));
+    memcpy(&bits1, &weights[1], sizeof(bits1));
+    uint32_t magnitude0 = bits0 & 0x7FFFFFFFu, magnitude1 = bits1 & 0x7FFFFFFFu; /* the order of >= 0 floats */
+    sp_grid_pair pair;
+    pair.ties_up = magnitude0 < magnitude1;
+    uint32_t small = pair.ties_up ? magnitude0 : magnitude1, large = pair.ties_up ? magnitude1 : magnitude0;
+    uint32_t small_exponent = small >> 23, large_exponent = large >> 23;
+    pair.small = (small & 0x7FFFFFu) | (small_exponent ? 0x800000u : 0);
+    pair.large = (large & 0x7FFFFFu) | (large_exponent ? 0x800000u : 0);
+    small_exponent += small_exponent == 0, large_exponent += large_exponent == 0; /* denormals: 2^-149 units */
+    pair.gap = (large_exponent - small_exponent) * (uint32_t)(small != 0); /* no branch: zero weights are common */
+    pair.plain = (uint32_t)(bits0 <= 0x80000000u) & (uint32_t)(bits1 <= 0x80000000u) & /* >= 0 or -0 */
+                 (uint32_t)(large < 0x7F800000u) & (uint32_t)(large != 0);
+    return pair;
+}
+
+/* The largest gap sp_grid_round_pair takes: D < 2^(25 + gap) = 2^60, and its remainders fit 63
+ * bits (below). */
+#define SP_GRID_PAIR_GAP 35
+
+/*
+ * The K = 2 rounding of grids s >= SP_GRID_DOUBLE_LIMIT, exact: x = s small / D for the smaller
+ * weight and D = large 2^gap + small (so x <= s/2 < 2^63, and x < 2^(65 - gap) for gap > 0, as
+ * the larger weight is then normal) rounded to the nearest integer, ties as sp_grid_pair says;
+ * q = (s - that, that). Floor and remainder of s small / D come from x86-64's DIV where it is
+ * there (SP_NARROW_DIVIDE: 3.7 against 5.9 ns a vertex); elsewhere from a double estimate f of x
+ * (5 roundings: within 2^-50 x + 1 of it), the remainder s small - f D exactly (|r| < (2^(15 -
+ * gap) + 2) D < 2^62, so modulo 2^64 is exact), f corrected by r / D in double (within 2^-35 of
+ * the truth, so the remainder is then below 1.01 D) and a last +-1 from the exact remainder's
+ * comparison with D/2.
+ * grid is s as a double (a loop's constant). Returns 0, q untouched, for input that is not plain
+ * or has a gap past SP_GRID_PAIR_GAP: the general rounding decides those.
+ */
+SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, double grid, uint64_t* q)
+{
+    sp_grid_pair pair = sp_grid_pair_parts(weights);
+    if (!pair.plain || pair.gap > SP_GRID_PAIR_GAP) return 0;
+    uint64_t sum = (pair.large << pair.gap) + pair.small, nearest;
+#if SP_NARROW_DIVIDE
+    uint64_t rest, whole = sp_u128_divide_narrow(sp_u128_mul_u64(sp_u128_from(s), pair.small), sum, &rest);
+    nearest = whole + (2 * rest + pair.ties_up > sum);
+    (void)grid;
+#else
+    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * grid * inverse;
+    estimate = estimate < 0x1.fffffffffffffp62 ? estimate : 0x1.fffffffffffffp62; /* (int64_t) stays defined */
+    int64_t whole = (int64_t)estimate;
+    int64_t rest = (int64_t)(s * pair.small - (uint64_t)whole * sum);
+    int64_t steps = (int64_t)((double)rest * inverse);
+    whole += steps;
+    rest -= steps * (int64_t)sum; /* |rest| < 1.01 D */
+    int64_t twice = 2 * rest + (int64_t)pair.ties_up, d = (int64_t)sum;
+    nearest = (uint64_t)(whole + (twice > d) - (twice <= -d));
+#endif
+    q[0] = s - nearest;
+    q[1] = nearest;
+    return 1;
+}
+
+/* Largest-remainder rounding of k weights (sorted, summing to ~1) to integers q summing to s:
+ * sp_grid_round where it applies, sp_grid_round_pair for K = 2 on larger grids, else the general
+ * rounding. */
 SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, uint64_t* q)
 {
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
-    if (s < ((uint64_t)1 << 50)) {
-        double remainder[SP_MAX_INFLUENCES] = {0, 0, 0, 0}, sum = 0;
-        SP_UNROLL for (uint32_t i = 0; i < k; ++i) sum += weights[i];
-        double scale = (double)s / sum;
-        int64_t deficit = (int64_t)s;
-        SP_UNROLL for (uint32_t i = 0; i < k; ++i) {
-            double x = weights[i] * scale;
-            x = sp_positive_or_zero(x);        /* also maps NaN to 0 */
-            x = x < (double)s ? x : (double)s; /* degenerate sums: keep the conversion defined */
-            int64_t f = (int64_t)x;
-            q[i] = (uint64_t)f;
-            remainder[i] = x - (double)f;
-            deficit -= f;
-        }
-        if (deficit >= 0 && deficit < (int64_t)k) {
-            /* rank[i]: components that win the bump before i (larger, or equal and lower);
-             * each pair is compared once, a < b wins when its remainder is not smaller. */
-            int64_t rank[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            SP_UNROLL for (uint32_t a = 0; a < k; ++a)
-                SP_UNROLL for (uint32_t b = a + 1; b < k; ++b) {
-                    int64_t a_wins = remainder[a] >= remainder[b];
-                    rank[b] += a_wins;
-                    rank[a] += 1 - a_wins;
-                }
-            SP_UNROLL for (uint32_t i = 0; i < k; ++i) q[i] += (uint64_t)(rank[i] < deficit);
-            return;
-        }
-    }
+    if (s < SP_GRID_DOUBLE_LIMIT) {
+        if (sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
+    } else if (k == 2 && sp_grid_round_pair(weights, s, (double)s, q))
+        return;
     sp_grid_quantize_general(weights, k, s, q);
 }
 

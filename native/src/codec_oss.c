@@ -123,19 +123,90 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
     return oss_pack(n, k, q);
 }
 
-/* One vertex after another with k constant, so the rounding and the index unroll into
- * straight-line code with q in registers. (Not in stages as the decoder: the staged form ran
- * ~3 % more instructions and was no faster at its best.) */
+/* The index of sorted grid coordinates for N below OSS_LAYER64_N (K = 4) or OSS_ROW64_N (K = 2,
+ * 3), with the codec's constants taken out of the closed forms: u(k) in Horner form
+ * ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 over 9 and s_b(j) for the row's bottom b = N - 2k as
+ * ((4N + 2 - 8k - 3j) j + 1) / 4, both modulo 2^64 (their values fit 64 bits, see the 64-bit
+ * forms above; negative intermediates wrap and come back). */
+typedef struct oss_pack_form {
+    uint64_t layer_linear, layer_constant, row_constant; /* -(6N + 9), 3N^2 + 9N + 6, 4N + 2 */
+} oss_pack_form;
+
+static oss_pack_form pack_form(uint64_t n)
+{
+    oss_pack_form form = {(uint64_t)0 - (6 * n + 9), 3 * n * n + 9 * n + 6, 4 * n + 2};
+    return form;
+}
+
+SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const uint64_t* q)
+{
+    if (k == 2) return q[1];
+    uint64_t layer = k == 4 ? q[3] : 0, row = q[2] - layer;
+    uint64_t row_base = ((form->row_constant - 8 * layer - 3 * row) * row + 1) / 4;
+    uint64_t layer_base =
+        k == 4 ? (((4 * layer + form->layer_linear) * layer + form->layer_constant) * layer + 2) / 9 : 0;
+    return layer_base + row_base + (q[1] - q[2]);
+}
+
+/* Vertices per stage of the scalar encoder: the grid scales (a division each, at the end of
+ * the sum's chain) of a chunk first, then their roundings and indices, so that the core
+ * overlaps the independent divisions instead of waiting for each. */
+#define ENCODE_CHUNK 16
+
+/* One chunk after another with k constant, so the rounding and the index unroll into
+ * straight-line code with q in registers: the index by oss_pack_small where `small` (N below
+ * the limits of its 64-bit forms), else by oss_pack. Vertices the double rounding does not
+ * settle take sp_oss_encode_one. */
+SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                                 uint64_t* codes, uint8_t* significant, uint32_t k, int small)
+{
+    uint64_t n = codec->n, s = codec->scale;
+    oss_pack_form form = pack_form(n);
+    for (size_t v = first; v < count; v += ENCODE_CHUNK) {
+        double scale[ENCODE_CHUNK];
+        size_t chunk = count - v < ENCODE_CHUNK ? count - v : ENCODE_CHUNK;
+        for (size_t c = 0; c < chunk; ++c) scale[c] = sp_grid_scale(weights + (v + c) * k, k, (double)s);
+        for (size_t c = 0; c < chunk; ++c) {
+            const float* vertex = weights + (v + c) * k;
+            uint64_t q[SP_MAX_INFLUENCES];
+            if (!sp_grid_round(vertex, k, s, scale[c], q)) {
+                codes[v + c] = sp_oss_encode_one(codec, vertex, significant ? significant + v + c : NULL);
+                continue;
+            }
+            if (significant) significant[v + c] = sp_grid_significant(q, k);
+            codes[v + c] = small ? oss_pack_small(&form, k, q) : oss_pack(n, k, q);
+        }
+    }
+}
+
+/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_round_pair, the code q[1];
+ * the pairs it leaves to the general rounding one at a time. */
+static void oss_encode_wide_pairs(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                                  uint64_t* codes, uint8_t* significant)
+{
+    uint64_t s = codec->scale;
+    double grid = (double)s;
+    for (size_t v = first; v < count; ++v) {
+        uint64_t q[2];
+        if (!sp_grid_round_pair(weights + v * 2, s, grid, q)) sp_grid_quantize_general(weights + v * 2, 2, s, q);
+        if (significant) significant[v] = (uint8_t)(1 + (q[1] > 0));
+        codes[v] = q[1];
+    }
+}
+
+/* The scalar encode with k constant: K = 2 codes past 50 bits by oss_encode_wide_pairs, the
+ * others in chunks (no grid of K = 3, 4 reaches SP_GRID_DOUBLE_LIMIT). */
 SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_t first, size_t count,
                               uint64_t* codes, uint8_t* significant, uint32_t k)
 {
-    uint64_t n = codec->n, scale = codec->scale;
-    for (size_t v = first; v < count; ++v) {
-        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-        sp_grid_quantize(weights + v * k, k, scale, q);
-        if (significant) significant[v] = sp_grid_significant(q, k);
-        codes[v] = oss_pack(n, k, q);
-    }
+    if (codec->scale >= SP_GRID_DOUBLE_LIMIT) {
+        if (k == 2) oss_encode_wide_pairs(codec, weights, first, count, codes, significant);
+        else
+            for (size_t v = first; v < count; ++v) codes[v] = sp_oss_encode_one(codec, weights + v * k, significant ? significant + v : NULL);
+    } else if (codec->n < (k == 4 ? OSS_LAYER64_N : OSS_ROW64_N))
+        oss_encode_chunks(codec, weights, first, count, codes, significant, k, 1);
+    else
+        oss_encode_chunks(codec, weights, first, count, codes, significant, k, 0);
 }
 
 void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,

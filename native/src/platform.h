@@ -138,4 +138,21 @@ static inline sp_u128 sp_u128_mul_u64(sp_u128 a, uint64_t b) { return sp_u128_mu
 static inline sp_u128 sp_u128_add_u64(sp_u128 a, uint64_t b) { return sp_u128_add(a, sp_u128_from(b)); }
 static inline sp_u128 sp_u128_div_u64(sp_u128 a, uint64_t b) { return sp_u128_div(a, sp_u128_from(b)); }
 
+/* floor(a / b) and a mod b where the quotient fits 64 bits (b > a's high half), as x86-64's DIV
+ * does it in one instruction (the compiler's 128-bit division is a library call that cannot
+ * assume the bound). SP_NARROW_DIVIDE says whether it is there: callers keep a portable route,
+ * which the two-halves build (SP_PORTABLE_U128) takes. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(SP_PORTABLE_U128)
+#define SP_NARROW_DIVIDE 1
+static inline uint64_t sp_u128_divide_narrow(sp_u128 a, uint64_t b, uint64_t* remainder)
+{
+    uint64_t quotient, rest;
+    __asm__("divq %4" : "=a"(quotient), "=d"(rest) : "a"(sp_u128_low(a)), "d"(sp_u128_high(a)), "rm"(b) : "cc");
+    *remainder = rest;
+    return quotient;
+}
+#else
+#define SP_NARROW_DIVIDE 0
+#endif
+
 #endif

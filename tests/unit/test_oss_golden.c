@@ -5,6 +5,8 @@
  * the decoder, must give the same codes, significant counts and float bits. Every ISA the CPU
  * has must give them too. `test_oss_golden --print` prints the table from the code under test.
  */
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,7 +59,9 @@ typedef struct golden_row {
     uint64_t encode, decode, sampled;
 } golden_row;
 
-/* Recorded from commit 2cc7f20 (test_oss_golden --print built against it). */
+/* Recorded from commit 2cc7f20 (test_oss_golden --print built against it), but for K = 2 at 64
+ * bits (63-bit codes), re-recorded when that grid's rounding became exact (issue 14): 8 of its
+ * vertices were off the nearest grid point before. */
 static const golden_row golden[] = {
 #include "test_oss_golden.inc"
 };
@@ -82,12 +86,84 @@ static void checksums(const sp_codec* codec, const float* weights, sp_isa isa, g
     free(codes), free(significant), free(decoded);
 }
 
+
+/* Odd weights: slots drawn from a pool of special values (signed zeros, denormals, NaN, infinities,
+ * negatives, exact ties and halves), unsorted and not normalised, so that the rounding's
+ * degenerate paths (deficits out of range, zero or infinite sums, clamps) and its tie rules run;
+ * every 4th vertex is a sorted tuple of equal or halved weights. */
+static void make_odd_weights(uint32_t k, float* weights)
+{
+    static const float pool[] = {0.0f, -0.0f, 1.0f, 0.5f, 0.25f, 1.0f / 3, 2.0f / 3, 0.1f, 0.7f, 1e-30f, 1e-45f,
+                                 FLT_MIN, FLT_MAX, -0.5f, -1e-30f, NAN, INFINITY, -INFINITY, 3.0f, 1e30f};
+    for (size_t v = 0; v < VERTICES; ++v)
+        for (uint32_t i = 0; i < k; ++i) {
+            float w = pool[next_random() % (sizeof(pool) / sizeof(pool[0]))];
+            if (v % 4 == 0) w = i == 0 || next_random() % 2 ? 1.0f / (float)k : 0.5f / (float)k;
+            weights[v * k + i] = w;
+        }
+}
+
+typedef struct odd_row {
+    int method;
+    uint32_t k, budget;
+    uint64_t encode;
+} odd_row;
+
+/* Recorded from commit 7598b78 (test_oss_golden --print-odd built against it), before the
+ * scalar encoder's rounding was split into scale and round steps; the K = 2 rows of grids past
+ * 2^50 (Cube 64, POT 52 and 64, OSS 52 and 64 bits) re-recorded when their rounding became exact
+ * (issue 14): only finite non-negative pairs changed, each to test_oss_exact's exact result. */
+static const odd_row odd_golden[] = {
+#include "test_oss_golden_odd.inc"
+};
+
+/* Codes and significant counts of the odd weights, every method with a grid rounding. */
+static void odd_checks(int print, float* weights)
+{
+    static const uint32_t budgets[] = {16, 32, 52, 64};
+    static const sp_isa paths[] = {SP_ISA_SCALAR, SP_ISA_AVX2, SP_ISA_AVX512};
+    uint64_t* codes = malloc(VERTICES * sizeof(uint64_t));
+    uint8_t* significant = malloc(VERTICES);
+    size_t row = 0;
+    for (int m = 0; m < SP_METHOD_COUNT; ++m)
+        for (uint32_t k = 2; k <= 4; ++k)
+            for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+                sp_codec codec;
+                if ((sp_method)m == SP_METHOD_ANY || sp_codec_from_bits((sp_method)m, k, budgets[b], &codec) != SP_OK)
+                    continue;
+                rng_state = 0x51ED270B27A5A0F1ull + (uint64_t)m * 4096 + k * 64 + budgets[b];
+                make_odd_weights(k, weights);
+                for (size_t p = 0; p < (print ? 1 : sizeof(paths) / sizeof(paths[0])); ++p) {
+                    CHECK(sp_encode_weights_batch_isa(&codec, weights, VERTICES, codes, significant, paths[p]) == SP_OK);
+                    uint64_t hash = fnv(fnv(14695981039346656037ull, codes, VERTICES * sizeof(uint64_t)), significant,
+                                        VERTICES);
+                    if (print) {
+                        printf("{%d, %u, %u, 0x%016llxull},\n", m, k, budgets[b], (unsigned long long)hash);
+                        continue;
+                    }
+                    CHECK_MSG(row < sizeof(odd_golden) / sizeof(odd_golden[0]) && odd_golden[row].method == m &&
+                                  odd_golden[row].k == k && odd_golden[row].budget == budgets[b],
+                              "odd golden row %zu", row);
+                    CHECK_MSG(row < sizeof(odd_golden) / sizeof(odd_golden[0]) && hash == odd_golden[row].encode,
+                              "odd weights: %s K=%u %u bits isa %d", sp_method_name((sp_method)m), k, budgets[b],
+                              (int)paths[p]);
+                }
+                ++row;
+            }
+    free(codes), free(significant);
+}
+
 int main(int argc, char** argv)
 {
     static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
     static const sp_isa paths[] = {SP_ISA_SCALAR, SP_ISA_AVX2, SP_ISA_AVX512};
     int print = argc > 1 && strcmp(argv[1], "--print") == 0;
     float* weights = malloc(VERTICES * 4 * sizeof(float));
+    if (argc > 1 && strcmp(argv[1], "--print-odd") == 0) {
+        odd_checks(1, weights);
+        free(weights);
+        return 0;
+    }
     size_t row = 0;
     for (uint32_t k = 2; k <= 4; ++k)
         for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b, ++row) {
@@ -112,6 +188,7 @@ int main(int argc, char** argv)
                           (int)paths[p]);
             }
         }
+    if (!print) odd_checks(0, weights);
     free(weights);
     return print ? 0 : check_report("test_oss_golden");
 }
