@@ -2,7 +2,7 @@
  * OSS batch dispatch: which vector path takes a prefix of a batch, for which codecs. The
  * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
  * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
- * lanes, up to 64-bit codes. Both per ISA in codec_oss_wide_avx512.c and codec_oss_wide_avx2.c.
+ * lanes, up to 64-bit codes. Both per ISA in codec_oss_batch_avx512.c and codec_oss_batch_avx2.c.
  * What no vector path takes (K = 2 encode past N = 2^49, whose rounding is long double) is left to
  * the scalar loop in codec.c.
  */

@@ -1,6 +1,7 @@
 /*
  * The OSS block/chunk driver, written once over per-ISA primitives (internal; included by
- * codec_oss_batch_avx2.c and codec_oss_batch_avx512.c, the way meshoptimizer's vertexcodec
+ * codec_oss_batch_avx2.c and codec_oss_batch_avx512.c after codec_oss_prim_avx2.h /
+ * codec_oss_prim_avx512.h, the way meshoptimizer's vertexcodec
  * writes its SIMD group decoder per ISA and the driver once).
  *
  * Results are bit-identical to the scalar path (sp_grid_quantize + sp_oss_pack, and

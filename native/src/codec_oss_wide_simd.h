@@ -1,6 +1,6 @@
 /*
  * The OSS block/chunk driver for wide codes, written once over per-ISA primitives (internal;
- * included by codec_oss_wide_avx2.c and codec_oss_wide_avx512.c after the double-lane driver,
+ * included by codec_oss_batch_avx2.c and codec_oss_batch_avx512.c after the double-lane driver,
  * codec_oss_simd.h, whose primitives, rounding and estimates it reuses).
  *
  * Past the double lanes' exact range (codec_oss_batch.c: layer and row bases past 2^50) the
