@@ -51,15 +51,13 @@
 /*
  * Every driver (double lanes here, 32-bit lanes for narrow decode, codec_oss_wide_simd.h's
  * 64-bit lanes) walks a batch the same way: chunks of whole blocks, each chunk's stages over all
- * its blocks, then the scalar redo of the lanes it missed. The chunk is passed as a pointer to
- * an SP_INLINE function, a constant at every call that the compiler folds and inlines, with
- * `constants` the driver's per-codec values (NULL for the double lanes), computed once a batch.
+ * its blocks, then the scalar redo of the lanes it missed. The walks are written once as macros
+ * that define one walk function per chunk function, so that each chunk is a direct call the
+ * compiler inlines early with its constant k (through a function pointer, folded only later,
+ * decode took ~3-5% more instructions). A chunk takes (codec, constants, input, blocks, output...,
+ * k, layout), constants being the driver's per-codec values, computed once a batch (NULL for
+ * the double lanes).
  */
-typedef void (*encode_chunk_fn)(const sp_codec* codec, const void* constants, const float* weights, size_t blocks,
-                                uint64_t* codes, uint8_t* significant, uint32_t k, const simd_layout* layout);
-/* Returns 0, writing nothing, where the chunk holds a code above max_code. */
-typedef int (*decode_chunk_fn)(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t blocks,
-                               float* weights, uint32_t k, const simd_layout* layout);
 
 /* The scalar redo of the lanes of `blocks` blocks of `lanes` lanes set in missed[b] (a pass of
  * its own: a call among the vector stages would clobber every vector register). */
@@ -79,63 +77,53 @@ SP_INLINE SIMD_FN void redo_decode(const sp_codec* codec, const uint64_t* codes,
             if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
 }
 
-/* Full chunks with a constant block count (their stage loops unrolled), then the tail's blocks. */
-SP_INLINE SIMD_FN size_t encode_walk(encode_chunk_fn chunk, const sp_codec* codec, const void* constants,
-                                     const float* weights, size_t count, uint64_t* codes, uint8_t* significant, uint32_t k)
-{
-    simd_layout layout = layout_for(k);
-    size_t v = 0;
-    for (; v + ENCODE_CHUNK * BLOCK <= count; v += ENCODE_CHUNK * BLOCK)
-        chunk(codec, constants, weights + v * k, ENCODE_CHUNK, codes + v, significant ? significant + v : NULL, k, &layout);
-    size_t blocks = (count - v) / BLOCK;
-    if (blocks) chunk(codec, constants, weights + v * k, blocks, codes + v, significant ? significant + v : NULL, k, &layout);
-    return v + blocks * BLOCK;
-}
-
-SP_INLINE SIMD_FN size_t encode_any_k(encode_chunk_fn chunk, const sp_codec* codec, const void* constants,
-                                      const float* weights, size_t count, uint64_t* codes, uint8_t* significant)
-{
-    switch (codec->influences) { /* constant k: unrolled lanes */
-    case 2: return encode_walk(chunk, codec, constants, weights, count, codes, significant, 2);
-    case 3: return encode_walk(chunk, codec, constants, weights, count, codes, significant, 3);
-    default: return encode_walk(chunk, codec, constants, weights, count, codes, significant, 4);
+/* `name`: an encode over `chunk` (void, up to ENCODE_CHUNK blocks): full chunks with a constant
+ * block count (their stage loops unrolled), then the tail's blocks; returns the vertices done. */
+#define DEFINE_ENCODE_WALK(name, chunk)                                                                                  \
+    SP_INLINE SIMD_FN size_t name(const sp_codec* codec, const void* constants, const float* weights, size_t count,   \
+                                  uint64_t* codes, uint8_t* significant, uint32_t k)                                     \
+    {                                                                                                                    \
+        simd_layout layout = layout_for(k);                                                                              \
+        size_t v = 0;                                                                                                    \
+        for (; v + ENCODE_CHUNK * BLOCK <= count; v += ENCODE_CHUNK * BLOCK)                                             \
+            chunk(codec, constants, weights + v * k, ENCODE_CHUNK, codes + v, significant ? significant + v : NULL, k,  \
+                  &layout);                                                                                              \
+        size_t blocks = (count - v) / BLOCK;                                                                             \
+        if (blocks)                                                                                                      \
+            chunk(codec, constants, weights + v * k, blocks, codes + v, significant ? significant + v : NULL, k, &layout); \
+        return v + blocks * BLOCK;                                                                                       \
     }
-}
 
-/* Chunks of up to `most` blocks of `lanes` lanes from vertex v; returns where it stopped. At a
- * chunk holding an invalid code: with `salvage` (BLOCK lanes) the blocks before the invalid
- * code's block are decoded and the walk ends after them (the scalar loop reports the code),
- * without it the walk ends before the chunk (for a walk in other lanes to go on from). */
-SP_INLINE SIMD_FN size_t decode_walk(decode_chunk_fn chunk, const sp_codec* codec, const void* constants,
-                                     const uint64_t* codes, size_t v, size_t count, float* weights, uint32_t k,
-                                     const simd_layout* layout, size_t lanes, size_t most, int salvage)
-{
-    while (v + lanes <= count) {
-        size_t blocks = (count - v) / lanes, valid = 0;
-        if (blocks > most) blocks = most;
-        if (!chunk(codec, constants, codes + v, blocks, weights + v * k, k, layout)) {
-            while (salvage && valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
-            if (valid) chunk(codec, constants, codes + v, valid, weights + v * k, k, layout);
-            return v + valid * lanes;
-        }
-        v += blocks * lanes;
+/* `name`: a decode over `chunk` (int: 0, writing nothing, where the chunk holds a code above
+ * max_code) in chunks of up to `most` blocks of `lanes` lanes from vertex v; returns where it
+ * stopped. At a chunk holding an invalid code: with `salvage` (BLOCK lanes) the blocks before
+ * the invalid code's block are decoded and the walk ends after them (the scalar loop reports the
+ * code); without it the walk ends before the chunk (for a walk in other lanes to go on from). */
+#define DEFINE_DECODE_WALK(name, chunk)                                                                                  \
+    SP_INLINE SIMD_FN size_t name(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t v,      \
+                                  size_t count, float* weights, uint32_t k, const simd_layout* layout, size_t lanes,   \
+                                  size_t most, int salvage)                                                              \
+    {                                                                                                                    \
+        while (v + lanes <= count) {                                                                                     \
+            size_t blocks = (count - v) / lanes, valid = 0;                                                              \
+            if (blocks > most) blocks = most;                                                                            \
+            if (!chunk(codec, constants, codes + v, blocks, weights + v * k, k, layout)) {                               \
+                while (salvage && valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;    \
+                if (valid) chunk(codec, constants, codes + v, valid, weights + v * k, k, layout);                        \
+                return v + valid * lanes;                                                                                \
+            }                                                                                                            \
+            v += blocks * lanes;                                                                                         \
+        }                                                                                                                \
+        return v;                                                                                                        \
     }
-    return v;
-}
 
-/* A driver's whole decode of one k (decode_walk calls for its lanes). */
-typedef size_t (*decode_blocks_fn)(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t count,
-                                   float* weights, uint32_t k);
-
-SP_INLINE SIMD_FN size_t decode_any_k(decode_blocks_fn blocks, const sp_codec* codec, const void* constants,
-                                      const uint64_t* codes, size_t count, float* weights)
-{
-    switch (codec->influences) {
-    case 2: return blocks(codec, constants, codes, count, weights, 2);
-    case 3: return blocks(codec, constants, codes, count, weights, 3);
-    default: return blocks(codec, constants, codes, count, weights, 4);
+/* return f(arguments..., k) with the codec's k as a constant (unrolled lanes). */
+#define RETURN_FOR_EACH_K(codec, f, ...)                                                                                 \
+    switch ((codec)->influences) {                                                                                       \
+    case 2: return f(__VA_ARGS__, 2);                                                                                    \
+    case 3: return f(__VA_ARGS__, 3);                                                                                    \
+    default: return f(__VA_ARGS__, 4);                                                                                   \
     }
-}
 
 /* s_B(j) = floor(((4B + 2 - 3j) j + 1) / 4) for rows inside the triangle (positive), as
  * floor((B + 1/2 - 3j/4) j + 1/4): every exact intermediate is a multiple of 1/4 below 2^50, so
@@ -265,7 +253,7 @@ SP_INLINE SIMD_FN void store_block(const vec* q, uint32_t k, double n, uint64_t*
  * its rounding, the indices (the last three one stage where ENCODE_FUSED: with 32 registers a
  * block's floors stay in registers through the rounding and the index, ~15% faster for K = 3, 4
  * on AVX-512; with 16 they spill, ~25% slower for K = 4 on AVX2), and the scalar redo of the
- * lanes the vector code cannot prove exact. An encode_chunk_fn. */
+ * lanes the vector code cannot prove exact. */
 SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants, const float* weights, size_t blocks,
                                     uint64_t* codes, uint8_t* significant, uint32_t k, const simd_layout* layout)
 {
@@ -294,10 +282,12 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }
 
+DEFINE_ENCODE_WALK(encode_walk, encode_chunk)
+
 SIMD_FN size_t SIMD_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
-    return encode_any_k(encode_chunk, codec, NULL, weights, count, codes, significant);
+    RETURN_FOR_EACH_K(codec, encode_walk, codec, NULL, weights, count, codes, significant)
 }
 
 /* ---- decode ----------------------------------------------------------------------------- */
@@ -396,7 +386,7 @@ SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bo
  * The layer needs no check of its own: with k clamped to the layers, the row check accepts
  * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
- * and then (k, row, i) is the one tuple whose index is code. A decode_chunk_fn. */
+ * and then (k, row, i) is the one tuple whose index is code. */
 SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t blocks,
                                    float* weights, uint32_t k, const simd_layout* layout)
 {
@@ -438,6 +428,8 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants,
     if (any) redo_decode(codec, codes, blocks, BLOCK, missed, k, weights);
     return 1;
 }
+
+DEFINE_DECODE_WALK(decode_walk, decode_chunk)
 
 /* ---- decode in 32-bit lanes ------------------------------------------------------------- */
 
@@ -529,7 +521,7 @@ SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex,
 
 /* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there;
  * the codes are checked against max_code as they are loaded, and a chunk holding an invalid
- * one is left to the caller, unwritten (returns 0). A decode_chunk_fn. */
+ * one is left to the caller, unwritten (returns 0). */
 SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                           size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
@@ -565,19 +557,21 @@ SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* con
     return 1;
 }
 
+DEFINE_DECODE_WALK(decode_walk_narrow, decode_chunk_narrow)
+
 /* The narrow chunks up to the first one holding an invalid code (narrow codecs), then the
- * double lanes from there to the end or to the block holding it. A decode_blocks_fn. */
+ * double lanes from there to the end or to the block holding it. */
 SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                        size_t count, float* weights, uint32_t k)
 {
     simd_layout layout = layout_for(k);
     size_t v = narrow_decode(codec, k)
-                   ? decode_walk(decode_chunk_narrow, codec, constants, codes, 0, count, weights, k, &layout, NBLOCK, NARROW_CHUNK, 0)
+                   ? decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout, NBLOCK, NARROW_CHUNK, 0)
                    : 0;
-    return decode_walk(decode_chunk, codec, constants, codes, v, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
+    return decode_walk(codec, constants, codes, v, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
 }
 
 SIMD_FN size_t SIMD_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
 {
-    return decode_any_k(decode_blocks, codec, NULL, codes, count, weights);
+    RETURN_FOR_EACH_K(codec, decode_blocks, codec, NULL, codes, count, weights)
 }

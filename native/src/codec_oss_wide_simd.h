@@ -163,8 +163,8 @@ SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, 
 
 /* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
  * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
- * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes. An
- * encode_chunk_fn; constants: the wide_codec. */
+ * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes; constants: the
+ * wide_codec. */
 SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* constants, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
                                          const simd_layout* layout)
@@ -195,11 +195,13 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
 }
 
+DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
+
 SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
     wide_codec c = wide_codec_for(codec);
-    return encode_any_k(wide_encode_chunk, codec, &c, weights, count, codes, significant);
+    RETURN_FOR_EACH_K(codec, wide_encode_walk, codec, &c, weights, count, codes, significant)
 }
 
 /* ---- decode ----------------------------------------------------------------------------- */
@@ -274,8 +276,7 @@ SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, uvec code, vec* lay
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
  * codec_oss_simd.h (K = 4: the layer root's two halves, the layer and the row estimate, the rest;
  * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed; nothing
- * written where a code is above max_code (returns 0). A decode_chunk_fn; constants: the
- * wide_codec. */
+ * written where a code is above max_code (returns 0); constants: the wide_codec. */
 SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
@@ -322,16 +323,18 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     return 1;
 }
 
-/* The chunks to the end or to the block holding an invalid code. A decode_blocks_fn. */
+DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk)
+
+/* The chunks to the end or to the block holding an invalid code. */
 SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                             size_t count, float* weights, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    return decode_walk(wide_decode_chunk, codec, constants, codes, 0, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
+    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
 }
 
 SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
 {
     wide_codec c = wide_codec_for(codec);
-    return decode_any_k(wide_decode_blocks, codec, &c, codes, count, weights);
+    RETURN_FOR_EACH_K(codec, wide_decode_blocks, codec, &c, codes, count, weights)
 }
