@@ -52,11 +52,12 @@
  * Every driver (double lanes here, 32-bit lanes for narrow decode, codec_oss_wide_simd.h's
  * 64-bit lanes) walks a batch the same way: chunks of whole blocks, each chunk's stages over all
  * its blocks, then the scalar redo of the lanes it missed. The walks are written once as macros
- * that define one walk function per chunk function, so that each chunk is a direct call the
- * compiler inlines early with its constant k (through a function pointer, folded only later,
- * decode took ~3-5% more instructions). A chunk takes (codec, constants, input, blocks, output...,
- * k, layout), constants being the driver's per-codec values, computed once a batch (NULL for
- * the double lanes).
+ * that define one walk function per chunk function, with the block size, chunk size and salvage
+ * mode as literal constants: each chunk is a direct call inlined into a walk whose loop bounds
+ * are known (as function parameters, folded only after inlining, decode ran 3-5% more
+ * instructions under callgrind). A chunk takes (codec, constants, input, blocks, output..., k,
+ * layout), constants being the driver's per-codec values, computed once a batch (NULL for the
+ * double lanes).
  */
 
 /* The scalar redo of the lanes of `blocks` blocks of `lanes` lanes set in missed[b] (a pass of
@@ -99,10 +100,9 @@ SP_INLINE SIMD_FN void redo_decode(const sp_codec* codec, const uint64_t* codes,
  * stopped. At a chunk holding an invalid code: with `salvage` (BLOCK lanes) the blocks before
  * the invalid code's block are decoded and the walk ends after them (the scalar loop reports the
  * code); without it the walk ends before the chunk (for a walk in other lanes to go on from). */
-#define DEFINE_DECODE_WALK(name, chunk)                                                                                  \
+#define DEFINE_DECODE_WALK(name, chunk, lanes, most, salvage)                                                            \
     SP_INLINE SIMD_FN size_t name(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t v,      \
-                                  size_t count, float* weights, uint32_t k, const simd_layout* layout, size_t lanes,   \
-                                  size_t most, int salvage)                                                              \
+                                  size_t count, float* weights, uint32_t k, const simd_layout* layout)                 \
     {                                                                                                                    \
         while (v + lanes <= count) {                                                                                     \
             size_t blocks = (count - v) / lanes, valid = 0;                                                              \
@@ -429,7 +429,7 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants,
     return 1;
 }
 
-DEFINE_DECODE_WALK(decode_walk, decode_chunk)
+DEFINE_DECODE_WALK(decode_walk, decode_chunk, BLOCK, DECODE_CHUNK, 1)
 
 /* ---- decode in 32-bit lanes ------------------------------------------------------------- */
 
@@ -557,7 +557,7 @@ SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* con
     return 1;
 }
 
-DEFINE_DECODE_WALK(decode_walk_narrow, decode_chunk_narrow)
+DEFINE_DECODE_WALK(decode_walk_narrow, decode_chunk_narrow, NBLOCK, NARROW_CHUNK, 0)
 
 /* The narrow chunks up to the first one holding an invalid code (narrow codecs), then the
  * double lanes from there to the end or to the block holding it. */
@@ -566,9 +566,9 @@ SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* consta
 {
     simd_layout layout = layout_for(k);
     size_t v = narrow_decode(codec, k)
-                   ? decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout, NBLOCK, NARROW_CHUNK, 0)
+                   ? decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout)
                    : 0;
-    return decode_walk(codec, constants, codes, v, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
+    return decode_walk(codec, constants, codes, v, count, weights, k, &layout);
 }
 
 SIMD_FN size_t SIMD_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)

@@ -285,8 +285,9 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
     root z[DECODE_CHUNK];
     unsigned missed[DECODE_CHUNK]; /* lanes as bits */
-    for (size_t b = 0; b < blocks; ++b)
-        if (!codes_valid(codes + b * BLOCK, codec->max_code)) return 0;
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
+    if (!check_passed(&check)) return 0;
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
@@ -323,14 +324,14 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     return 1;
 }
 
-DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk)
+DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk, BLOCK, DECODE_CHUNK, 1)
 
 /* The chunks to the end or to the block holding an invalid code. */
 SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                             size_t count, float* weights, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout, BLOCK, DECODE_CHUNK, 1);
+    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
 }
 
 SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
