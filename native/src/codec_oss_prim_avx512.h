@@ -85,7 +85,7 @@ SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm512_cvttps_epi32(a); } /* NaN
 SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm512_castps_si512(a); }
 SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm512_castsi512_ps(a); }
 
-/* floor(a / 9) for 0 <= a < 2^33, as the AVX2 path (codec_oss_batch_avx2.c). */
+/* floor(a / 9) for 0 <= a < 2^33, as the AVX2 path (codec_oss_prim_avx2.h). */
 SP_INLINE SIMD_FN nint i_div9(nint a)
 {
     __m512i m = _mm512_set1_epi32(954437177);
@@ -187,7 +187,7 @@ SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t 
 
 /* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes
  * by Markstein's correction of q r, the correctly rounded q/s as the double product (see
- * store_weights32 in codec_oss_batch_avx2.c), then each half as store_weights stores it. */
+ * store_weights32 in codec_oss_prim_avx2.h), then each half as store_weights stores it. */
 SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
 {
     __m512 w[SP_MAX_INFLUENCES], s = _mm512_set1_ps((float)scale), r = _mm512_set1_ps(1.0f / (float)scale);
