@@ -2,7 +2,7 @@
  * OSS batch dispatch: which vector path takes a prefix of a batch, for which codecs. The
  * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
  * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
- * lanes, up to 64-bit codes. Both per ISA in codec_oss_wide_avx512.c and codec_oss_wide_avx2.c.
+ * lanes, up to 64-bit codes. Both per ISA in codec_oss_batch_avx512.c and codec_oss_batch_avx2.c.
  * What no vector path takes (K = 2 encode past N = 2^49, whose rounding is long double) is left to
  * the scalar loop in codec.c.
  */
@@ -57,10 +57,8 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 #if SP_X86_SIMD
     oss_lanes lanes = oss_lanes_for(codec, 1);
     sp_isa isa = batch_isa(lanes, widest);
-    size_t (*avx512)(const sp_codec*, const float*, size_t, uint64_t*, uint8_t*) =
-        lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
-    size_t (*avx2)(const sp_codec*, const float*, size_t, uint64_t*, uint8_t*) =
-        lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
+    sp_oss_encode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
+    sp_oss_encode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
     if (isa >= SP_ISA_AVX512) done = avx512(codec, weights, count, codes, significant);
     if (isa >= SP_ISA_AVX2 && done < count)
         done += avx2(codec, weights + done * codec->influences, count - done, codes + done,
@@ -77,10 +75,8 @@ size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t 
 #if SP_X86_SIMD
     oss_lanes lanes = oss_lanes_for(codec, 0);
     sp_isa isa = batch_isa(lanes, widest);
-    size_t (*avx512)(const sp_codec*, const uint64_t*, size_t, float*) =
-        lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
-    size_t (*avx2)(const sp_codec*, const uint64_t*, size_t, float*) =
-        lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
+    sp_oss_decode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
+    sp_oss_decode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
     if (isa >= SP_ISA_AVX512) done = avx512(codec, codes, count, weights);
     if (isa >= SP_ISA_AVX2 && done < count) done += avx2(codec, codes + done, count - done, weights + done * codec->influences);
 #else

@@ -2,7 +2,7 @@
  * The OSS batch paths for codes past the double lanes' exact range (internal): K = 3 past
  * N = 2^24, K = 4 past N = 3 * 2^15 (every width up to 64 bits), K = 2 decode past N = 2^48 and
  * its encode up to N = 2^49. The driver is codec_oss_wide_simd.h, the per-ISA files
- * codec_oss_wide_avx2.c and codec_oss_wide_avx512.c; codec_oss_batch.c dispatches.
+ * codec_oss_batch_avx2.c and codec_oss_batch_avx512.c; codec_oss_batch.c dispatches.
  */
 #ifndef SKINPACK_CODEC_OSS_WIDE_H
 #define SKINPACK_CODEC_OSS_WIDE_H
@@ -17,12 +17,12 @@
  * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and
  * sp_oss_decode_one; return how many leading vertices were done. Decode stops before a block
  * holding a code above max_code. Call only where sp_cpu_isa() has the ISA and
- * sp_oss_wide_encode_supported / sp_oss_wide_decode_supported (codec_oss_batch.c) allow it. */
-size_t sp_oss_wide_encode_avx2(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                               uint8_t* significant);
-size_t sp_oss_wide_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
-size_t sp_oss_wide_encode_avx512(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                                 uint8_t* significant);
-size_t sp_oss_wide_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+ * codec_oss_batch.c's oss_lanes_for allows it. The types are those of every per-ISA path
+ * (codec_internal.h's sp_oss_encode_avx2 ... too), and of the dispatch's pointers. */
+typedef size_t sp_oss_encode_path(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
+                                  uint8_t* significant);
+typedef size_t sp_oss_decode_path(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+sp_oss_encode_path sp_oss_wide_encode_avx2, sp_oss_wide_encode_avx512;
+sp_oss_decode_path sp_oss_wide_decode_avx2, sp_oss_wide_decode_avx512;
 
 #endif

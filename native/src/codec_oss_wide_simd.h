@@ -1,6 +1,6 @@
 /*
  * The OSS block/chunk driver for wide codes, written once over per-ISA primitives (internal;
- * included by codec_oss_wide_avx2.c and codec_oss_wide_avx512.c after the double-lane driver,
+ * included by codec_oss_batch_avx2.c and codec_oss_batch_avx512.c after the double-lane driver,
  * codec_oss_simd.h, whose primitives, rounding and estimates it reuses).
  *
  * Past the double lanes' exact range (codec_oss_batch.c: layer and row bases past 2^50) the
@@ -163,11 +163,13 @@ SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, 
 
 /* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
  * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
- * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes. */
-SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec* c, const float* weights,
+ * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes; constants: the
+ * wide_codec. */
+SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* constants, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
                                          const simd_layout* layout)
 {
+    const wide_codec* c = (const wide_codec*)constants;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
@@ -190,34 +192,16 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const wide_codec
             if (significant) store_significant(q[b], k, significant + b * BLOCK);
         }
     }
-    for (size_t b = 0; b < blocks; ++b)
-        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
-            if (slow & 1) codes[lane] = sp_oss_encode_one(codec, weights + lane * k, significant ? significant + lane : NULL);
+    redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
 }
 
-SP_INLINE SIMD_FN size_t wide_encode_blocks(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
-                                            uint8_t* significant, uint32_t k)
-{
-    simd_layout layout = layout_for(k);
-    wide_codec c = wide_codec_for(codec);
-    size_t v = 0;
-    while (v + BLOCK <= count) {
-        size_t blocks = (count - v) / BLOCK;
-        if (blocks > ENCODE_CHUNK) blocks = ENCODE_CHUNK;
-        wide_encode_chunk(codec, &c, weights + v * k, blocks, codes + v, significant ? significant + v : NULL, k, &layout);
-        v += blocks * BLOCK;
-    }
-    return v;
-}
+DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
 
 SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
-    switch (codec->influences) { /* constant k: unrolled lanes */
-    case 2: return wide_encode_blocks(codec, weights, count, codes, significant, 2);
-    case 3: return wide_encode_blocks(codec, weights, count, codes, significant, 3);
-    default: return wide_encode_blocks(codec, weights, count, codes, significant, 4);
-    }
+    wide_codec c = wide_codec_for(codec);
+    RETURN_FOR_EACH_K(codec, wide_encode_walk, codec, &c, weights, count, codes, significant)
 }
 
 /* ---- decode ----------------------------------------------------------------------------- */
@@ -289,16 +273,21 @@ SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, uvec code, vec* lay
     return v_sub(rest, v_add_where(v_zero(), above, length));
 }
 
-/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes <= max_code, in stages as in
+/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
  * codec_oss_simd.h (K = 4: the layer root's two halves, the layer and the row estimate, the rest;
- * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed. */
-SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec* c, const uint64_t* codes,
-                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
+ * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed; nothing
+ * written where a code is above max_code (returns 0); constants: the wide_codec. */
+SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                        size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
+    const wide_codec* c = (const wide_codec*)constants;
     double inverse = 1.0 / (double)codec->scale;
     vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
     root z[DECODE_CHUNK];
     unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
+    if (!check_passed(&check)) return 0;
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
@@ -331,33 +320,22 @@ SP_INLINE SIMD_FN void wide_decode_chunk(const sp_codec* codec, const wide_codec
             store_weights(q, 4, inverse, layout, out);
         }
     }
-    for (size_t b = 0; b < blocks; ++b)
-        for (size_t lane = b * BLOCK, slow = missed[b]; slow; ++lane, slow >>= 1)
-            if (slow & 1) sp_oss_decode_one(codec, codes[lane], weights + lane * k);
+    redo_decode(codec, codes, blocks, BLOCK, missed, k, weights);
+    return 1;
 }
 
-SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
-                                            uint32_t k)
+DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk, BLOCK, DECODE_CHUNK, 1)
+
+/* The chunks to the end or to the block holding an invalid code. */
+SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                            size_t count, float* weights, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    wide_codec c = wide_codec_for(codec);
-    size_t v = 0;
-    while (v + BLOCK <= count) {
-        size_t blocks = (count - v) / BLOCK, valid = 0;
-        if (blocks > DECODE_CHUNK) blocks = DECODE_CHUNK;
-        while (valid < blocks && codes_valid(codes + v + valid * BLOCK, codec->max_code)) ++valid;
-        if (valid == 0) break; /* an invalid code: the scalar loop reports the first one */
-        wide_decode_chunk(codec, &c, codes + v, valid, weights + v * k, k, &layout);
-        v += valid * BLOCK;
-    }
-    return v;
+    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
 }
 
 SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
 {
-    switch (codec->influences) {
-    case 2: return wide_decode_blocks(codec, codes, count, weights, 2);
-    case 3: return wide_decode_blocks(codec, codes, count, weights, 3);
-    default: return wide_decode_blocks(codec, codes, count, weights, 4);
-    }
+    wide_codec c = wide_codec_for(codec);
+    RETURN_FOR_EACH_K(codec, wide_decode_blocks, codec, &c, codes, count, weights)
 }

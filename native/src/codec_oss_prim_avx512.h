@@ -1,0 +1,309 @@
+/*
+ * AVX-512 (F, DQ, VL) primitives of the OSS batch drivers (codec_oss_simd.h,
+ * codec_oss_wide_simd.h), included by codec_oss_batch_avx512.c only: eight double lanes
+ * (sixteen float / int32 lanes for narrow decode), compare masks in mask registers, the AoS
+ * weights moved in and out with two-source permutes, and rcp14 estimates in the layer root.
+ */
+#ifndef SKINPACK_CODEC_OSS_PRIM_AVX512_H
+#define SKINPACK_CODEC_OSS_PRIM_AVX512_H
+
+#include "codec_internal.h"
+
+#if SP_X86_SIMD
+#include <immintrin.h>
+
+SP_FP_CONTRACT_OFF /* avx512f implies fma */
+#define SIMD_FN SP_TARGET("avx512f,avx512dq,avx512vl")
+#define SIMD_NAME(name) sp_oss_##name##_avx512
+#define BLOCK 8
+#define ENCODE_CHUNK 16 /* blocks per stage: on Zen 5, 8 is ~3% slower for K = 3, 4, 32 no faster */
+#define DECODE_CHUNK 16 /* on Zen 5, 8 is ~5% slower for K = 3, 4 decode (4 was ~20% slower on Zen 4) */
+#define ENCODE_FUSED 1  /* K = 3, 4 encode ~15% faster on Zen 5 than in three stages */
+
+typedef __m512d vec;
+typedef __mmask8 mask;
+typedef __m256 root;
+/* Permute indices between 8 vertices of k floats and component pairs (see soa_index). */
+typedef struct simd_layout {
+    __m512i soa[2], aos[2];
+} simd_layout;
+
+SP_INLINE SIMD_FN vec v_splat(double x) { return _mm512_set1_pd(x); }
+SP_INLINE SIMD_FN vec v_zero(void) { return _mm512_setzero_pd(); }
+SP_INLINE SIMD_FN vec v_add(vec a, vec b) { return _mm512_add_pd(a, b); }
+SP_INLINE SIMD_FN vec v_sub(vec a, vec b) { return _mm512_sub_pd(a, b); }
+SP_INLINE SIMD_FN vec v_mul(vec a, vec b) { return _mm512_mul_pd(a, b); }
+SP_INLINE SIMD_FN vec v_div(vec a, vec b) { return _mm512_div_pd(a, b); }
+SP_INLINE SIMD_FN vec v_sqrt(vec a) { return _mm512_sqrt_pd(a); }
+SP_INLINE SIMD_FN vec v_max(vec a, vec b) { return _mm512_max_pd(a, b); }
+SP_INLINE SIMD_FN vec v_min(vec a, vec b) { return _mm512_min_pd(a, b); }
+SP_INLINE SIMD_FN vec v_floor(vec a) { return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+SP_INLINE SIMD_FN vec v_trunc(vec a) { return _mm512_roundscale_pd(a, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC); }
+SP_INLINE SIMD_FN vec v_fmadd(vec a, vec b, vec c) { return _mm512_fmadd_pd(a, b, c); }
+SP_INLINE SIMD_FN vec v_fnmadd(vec a, vec b, vec c) { return _mm512_fnmadd_pd(a, b, c); }
+SP_INLINE SIMD_FN vec v_fmsub(vec a, vec b, vec c) { return _mm512_fmsub_pd(a, b, c); }
+SP_INLINE SIMD_FN mask m_ge(vec a, vec b) { return _mm512_cmp_pd_mask(a, b, _CMP_GE_OQ); }
+SP_INLINE SIMD_FN mask m_gt(vec a, vec b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+SP_INLINE SIMD_FN mask m_lt(vec a, vec b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+SP_INLINE SIMD_FN mask m_and(mask a, mask b) { return (mask)(a & b); }
+SP_INLINE SIMD_FN unsigned m_bits(mask a) { return a; }
+SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm512_mask_add_pd(x, m, x, y); }
+
+/* Counters as plain doubles: a masked add is one instruction already. */
+typedef __m512d counter;
+SP_INLINE SIMD_FN counter c_splat(uint32_t c) { return v_splat(c); }
+SP_INLINE SIMD_FN counter c_inc_where(counter c, mask m) { return v_add_where(c, m, v_splat(1.0)); }
+SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m) { return v_add_where(c, m, v_splat(-1.0)); }
+SP_INLINE SIMD_FN vec c_threshold(vec d) { return d; }
+SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
+
+/* Sixteen float or int32 lanes for decode in 32-bit lanes. */
+#define NBLOCK 16
+#define NARROW_CHUNK 16 /* blocks a stage (256 vertices): K = 4 ~3% faster than 8 */
+typedef __m512 nvec;
+typedef __m512i nint;
+typedef __mmask16 nmask;
+SP_INLINE SIMD_FN nvec f_splat(float x) { return _mm512_set1_ps(x); }
+SP_INLINE SIMD_FN nvec f_add(nvec a, nvec b) { return _mm512_add_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sub(nvec a, nvec b) { return _mm512_sub_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_mul(nvec a, nvec b) { return _mm512_mul_ps(a, b); }
+SP_INLINE SIMD_FN nvec f_sqrt(nvec a) { return _mm512_sqrt_ps(a); }
+SP_INLINE SIMD_FN nvec f_fmadd(nvec a, nvec b, nvec c) { return _mm512_fmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nvec f_fnmadd(nvec a, nvec b, nvec c) { return _mm512_fnmadd_ps(a, b, c); }
+SP_INLINE SIMD_FN nint i_splat(int32_t x) { return _mm512_set1_epi32(x); }
+SP_INLINE SIMD_FN nint i_add(nint a, nint b) { return _mm512_add_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_sub(nint a, nint b) { return _mm512_sub_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_mullo(nint a, nint b) { return _mm512_mullo_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_max(nint a, nint b) { return _mm512_max_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_min(nint a, nint b) { return _mm512_min_epi32(a, b); }
+SP_INLINE SIMD_FN nint i_shr2(nint a) { return _mm512_srai_epi32(a, 2); }
+SP_INLINE SIMD_FN nmask i_gt(nint a, nint b) { return _mm512_cmpgt_epi32_mask(a, b); }
+SP_INLINE SIMD_FN nmask n_or(nmask a, nmask b) { return (nmask)(a | b); }
+SP_INLINE SIMD_FN unsigned n_bits(nmask a) { return a; }
+SP_INLINE SIMD_FN nvec i_to_f(nint a) { return _mm512_cvtepi32_ps(a); }
+SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm512_cvttps_epi32(a); } /* NaN and overflow: INT32_MIN */
+SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm512_castps_si512(a); }
+SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm512_castsi512_ps(a); }
+
+/* floor(a / 9) for 0 <= a < 2^33, as the AVX2 path (codec_oss_prim_avx2.h). */
+SP_INLINE SIMD_FN nint i_div9(nint a)
+{
+    __m512i m = _mm512_set1_epi32(954437177);
+    __m512i even = _mm512_srli_epi64(_mm512_mul_epu32(a, m), 33);
+    __m512i odd = _mm512_srli_epi64(_mm512_mul_epu32(_mm512_srli_epi64(a, 32), m), 1);
+    return _mm512_mask_blend_epi32((__mmask16)0xAAAA, even, odd);
+}
+
+/* Indices between 8 vertices of k floats (AoS, as two 16-float registers: floats 0..15 and
+ * floats 8k-16..8k-1, overlapping for k < 4) and component pairs (c, c + 1) of the 8 vertices
+ * (SoA, one register per pair: component c in the low half). */
+SP_INLINE SIMD_FN __m512i soa_index(uint32_t k, uint32_t pair)
+{
+    int32_t index[16];
+    for (uint32_t lane = 0; lane < 16; ++lane) {
+        uint32_t c = 2 * pair + lane / 8, f = (lane % 8) * k + (c < k ? c : 0);
+        index[lane] = (int32_t)(f < 16 ? f : 16 + f - (8 * k - 16));
+    }
+    return _mm512_loadu_si512(index);
+}
+
+/* The inverse: output float f (of 16 starting at float 16 * half) from the pair registers
+ * (pair 0 as indices 0..15, pair 1 as 16..31). */
+SP_INLINE SIMD_FN __m512i aos_index(uint32_t k, uint32_t half)
+{
+    int32_t index[16];
+    for (uint32_t lane = 0; lane < 16; ++lane) {
+        uint32_t f = 16 * half + lane, v = f / k, c = f % k;
+        index[lane] = (int32_t)(v < 8 ? (c / 2) * 16 + (c % 2) * 8 + v : 0);
+    }
+    return _mm512_loadu_si512(index);
+}
+
+SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
+{
+    simd_layout layout = {{soa_index(k, 0), soa_index(k, 1)}, {aos_index(k, 0), aos_index(k, 1)}};
+    return layout;
+}
+
+/* Component i of eight consecutive vertices of k weights, widened to double (exact). */
+SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layout* layout, vec* x)
+{
+    __m512 lo = _mm512_loadu_ps(w), hi = _mm512_loadu_ps(w + 8 * k - 16);
+    SP_UNROLL
+    for (uint32_t pair = 0; 2 * pair < k; ++pair) {
+        __m512 p = _mm512_permutex2var_ps(lo, layout->soa[pair], hi);
+        x[2 * pair] = _mm512_cvtps_pd(_mm512_castps512_ps256(p));
+        if (2 * pair + 1 < k) x[2 * pair + 1] = _mm512_cvtps_pd(_mm512_extractf32x8_ps(p, 1));
+    }
+}
+
+/* (float)(q * (1/s)) per component, as sp_grid_to_weights does, stored as eight vertices. */
+SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
+{
+    __m512 pair[2] = {_mm512_setzero_ps(), _mm512_setzero_ps()};
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) {
+        __m256 w = _mm512_cvtpd_ps(_mm512_mul_pd(q[i], v_splat(inverse)));
+        pair[i / 2] = i % 2 ? _mm512_insertf32x8(pair[i / 2], w, 1) : _mm512_castps256_ps512(w);
+    }
+    _mm512_storeu_ps(out, _mm512_permutex2var_ps(pair[0], layout->aos[0], pair[1]));
+    if (k > 2)
+        _mm512_mask_storeu_ps(out + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
+                              _mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1]));
+}
+
+/* Codes <= max_code: the largest code seen, compared once. */
+typedef struct code_check {
+    __m512i high;
+    uint64_t max_code;
+} code_check;
+
+SP_INLINE SIMD_FN code_check check_start(uint64_t max_code)
+{
+    code_check check = {_mm512_setzero_si512(), max_code};
+    return check;
+}
+
+SP_INLINE SIMD_FN int check_passed(const code_check* check)
+{
+    return !_mm512_cmpgt_epu64_mask(check->high, _mm512_set1_epi64((int64_t)check->max_code));
+}
+
+/* The low halves of sixteen codes, in order. */
+SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
+{
+    __m512i first = _mm512_loadu_si512(codes), second = _mm512_loadu_si512(codes + 8);
+    check->high = _mm512_max_epu64(check->high, _mm512_max_epu64(first, second));
+    return _mm512_inserti64x4(_mm512_castsi256_si512(_mm512_cvtepi64_epi32(first)), _mm512_cvtepi64_epi32(second), 1);
+}
+
+/* store_weights of two blocks, one after the other. */
+SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t k, double inverse,
+                                  const simd_layout* layout, float* out)
+{
+    store_weights(first, k, inverse, layout, out);
+    store_weights(second, k, inverse, layout, out + BLOCK * k);
+}
+
+/* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes
+ * by Markstein's correction of q r, the correctly rounded q/s as the double product (see
+ * store_weights32 in codec_oss_prim_avx2.h), then each half as store_weights stores it. */
+SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
+{
+    __m512 w[SP_MAX_INFLUENCES], s = _mm512_set1_ps((float)scale), r = _mm512_set1_ps(1.0f / (float)scale);
+    SP_UNROLL
+    for (uint32_t i = 0; i < k; ++i) {
+        __m512 x = _mm512_cvtepi32_ps(q[i]), y = _mm512_mul_ps(x, r);
+        w[i] = _mm512_fmadd_ps(_mm512_fnmadd_ps(y, s, x), r, y);
+    }
+    if (k == 3) w[3] = w[2]; /* the unused pair half */
+    /* pairs (c, c + 1) of vertices 0..7 (the low halves: 0x44) and 8..15 (the high ones: 0xEE) */
+    __m512 pairs[2][2] = {{_mm512_shuffle_f32x4(w[0], w[1], 0x44)}, {_mm512_shuffle_f32x4(w[0], w[1], 0xEE)}};
+    pairs[0][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0x44) : pairs[0][0];
+    pairs[1][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0xEE) : pairs[1][0];
+    SP_UNROLL
+    for (uint32_t half = 0; half < 2; ++half) {
+        float* at = out + half * BLOCK * k;
+        _mm512_storeu_ps(at, _mm512_permutex2var_ps(pairs[half][0], layout->aos[0], pairs[half][1]));
+        if (k > 2)
+            _mm512_mask_storeu_ps(at + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
+                                  _mm512_permutex2var_ps(pairs[half][0], layout->aos[1], pairs[half][1]));
+    }
+}
+
+SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)
+{
+    __m512i raw = _mm512_loadu_si512(codes);
+    check->high = _mm512_max_epu64(check->high, raw);
+    return _mm512_cvtepu64_pd(raw); /* exact below 2^53 */
+}
+
+SP_INLINE SIMD_FN void store_codes(uint64_t* codes, vec x)
+{
+    _mm512_storeu_si512(codes, _mm512_cvttpd_epu64(x));
+}
+
+SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
+{
+    _mm_storel_epi64((__m128i*)out, _mm512_cvtepi64_epi8(_mm512_cvttpd_epi64(count)));
+}
+
+SP_INLINE SIMD_FN int codes_valid(const uint64_t* codes, uint64_t max_code)
+{
+    return !_mm512_cmpgt_epu64_mask(_mm512_loadu_si512(codes), _mm512_set1_epi64((int64_t)max_code));
+}
+
+/*
+ * cbrt(x) + 1/cbrt(x) for the layer estimate, x >= 1: the float exponent/3 bit trick (3.2%), a
+ * Halley step in float with rcp14 for its division (~1e-4), then one Newton step in double whose
+ * 1/(3y^2) comes from rcp14 (its 2^-14 error only scales the already small correction), and 1/c
+ * from rcp14. An estimate only: no division or zmm square root (those were the bottleneck of an
+ * earlier double Halley step).
+ */
+SP_INLINE SIMD_FN root root_start(vec x)
+{
+    __m256 xf = _mm512_cvtpd_ps(x);
+    __m256i third = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_castps_si256(xf)), _mm256_set1_ps(1.0f / 3.0f)));
+    __m256 yf = _mm256_castsi256_ps(_mm256_add_epi32(third, _mm256_set1_epi32(709958130)));
+    __m256 yf3 = _mm256_mul_ps(_mm256_mul_ps(yf, yf), yf);
+    __m256 inverse = _mm256_rcp14_ps(_mm256_add_ps(_mm256_add_ps(yf3, yf3), xf));
+    return _mm256_mul_ps(_mm256_mul_ps(yf, _mm256_add_ps(yf3, _mm256_add_ps(xf, xf))), inverse); /* y (y^3 + 2x) / (2y^3 + x) */
+}
+
+SP_INLINE SIMD_FN vec root_finish(vec x, root yf)
+{
+    __m512d y = _mm512_cvtps_pd(yf);
+    __m512d y2 = _mm512_mul_pd(y, y);
+    __m512d r = _mm512_rcp14_pd(_mm512_mul_pd(y2, v_splat(3.0)));
+    __m512d c = _mm512_fnmadd_pd(_mm512_fmsub_pd(y2, y, x), r, y); /* y - (y^3 - x) / (3y^2) */
+    return _mm512_add_pd(c, _mm512_rcp14_pd(c));
+}
+
+/* The 64-bit integer lanes of the wide driver (codec_oss_wide_simd.h): vpmullq products,
+ * unsigned compares into mask registers, 64-bit conversions. */
+
+#define WIDE_NAME(name) sp_oss_wide_##name##_avx512
+
+#define WIDE_ROOT_NEWTON 0 /* its root (a double Newton step) is good to far below half a layer */
+
+typedef __m512i uvec;
+typedef __mmask8 umask;
+
+#define u_srl(a, n) _mm512_srli_epi64(a, n)
+#define u_sll(a, n) _mm512_slli_epi64(a, n)
+SP_INLINE SIMD_FN uvec u_splat(uint64_t x) { return _mm512_set1_epi64((int64_t)x); }
+SP_INLINE SIMD_FN uvec u_load(const uint64_t* p) { return _mm512_loadu_si512(p); }
+SP_INLINE SIMD_FN void u_store(uint64_t* p, uvec a) { _mm512_storeu_si512(p, a); }
+SP_INLINE SIMD_FN uvec u_add(uvec a, uvec b) { return _mm512_add_epi64(a, b); }
+SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm512_sub_epi64(a, b); }
+SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm512_and_si512(a, b); }
+SP_INLINE SIMD_FN uvec u_srlv(uvec a, uvec count) { return _mm512_srlv_epi64(a, count); }
+SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm512_mul_epu32(a, b); }
+SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b) { return _mm512_mullo_epi64(a, b); }
+SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_mul(a, b); }
+SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b) { return _mm512_cmplt_epu64_mask(a, b); }
+SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return _mm512_cmplt_epi64_mask(a, b); }
+SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
+SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
+SP_INLINE SIMD_FN vec v_from_u(uvec a) { return _mm512_cvtepu64_pd(a); }
+SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a) { return _mm512_cvtepu64_pd(a); } /* rounded to nearest */
+SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
+{
+    *high = _mm512_cvtepu64_pd(u_srl(a, 32));
+    *low = _mm512_cvtepu64_pd(u_and(a, u_splat(0xFFFFFFFFu)));
+}
+SP_INLINE SIMD_FN uvec u_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
+
+/* K = 2 and 3 weights: codec_oss_simd.h's store (two-source permutes) serves. */
+SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)
+{
+    vec q[2] = {q0, q1};
+    store_weights(q, 2, inverse, layout, out);
+}
+
+SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_layout* layout, float* out)
+{
+    store_weights(q, 3, inverse, layout, out);
+}
+#endif
+#endif
