@@ -204,8 +204,9 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
                            uint8_t* significant, sp_isa widest);
 size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                            sp_isa widest);
-/* Whether the vector paths are exact for this codec (OSS, K = 2..4, N in range). */
-int sp_oss_batch_supported(const sp_codec* codec);
+/* Whether a vector path is exact for this codec's encode (encode = 1) or decode (0): OSS,
+ * K = 2..4, N in range. */
+int sp_oss_batch_supported(const sp_codec* codec, int encode);
 
 /* The per-ISA paths (codec_oss_batch_avx2.c: blocks of 4; codec_oss_batch_avx512.c: blocks of
  * 8), same contract; call only where sp_cpu_isa() has the ISA and the codec is supported. */

@@ -285,7 +285,7 @@ static uint64_t find_row_wide(uint64_t n, uint64_t w, uint64_t* base)
 
 /*
  * cbrt(x) + 1/cbrt(x) for x >= 1 to ~1e-8 without a division or square root, as the AVX2 path
- * computes it (codec_oss_batch_avx2.c, root_start/root_finish): z ~ x^(-1/3) from the float
+ * computes it (codec_oss_prim_avx2.h, root_start/root_finish): z ~ x^(-1/3) from the float
  * exponent/3 bit trick and a third-order step, then c + z with c = x z^2 corrected by one
  * Newton step's first-order term.
  */

@@ -3,7 +3,7 @@
  * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
  * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
  * lanes, up to 64-bit codes. Both per ISA in codec_oss_batch_avx512.c and codec_oss_batch_avx2.c.
- * What no vector path takes (K = 2 encode past N = 2^49, whose rounding is long double) is left to
+ * What no vector path takes (K = 2 encode past N = 2^49, whose exact integer rounding has no vector form yet) is left to
  * the scalar loop in codec.c.
  */
 #include "codec_internal.h"
@@ -34,9 +34,9 @@ static oss_lanes oss_lanes_for(const sp_codec* codec, int encode)
     return LANES_WIDE;
 }
 
-int sp_oss_batch_supported(const sp_codec* codec)
+int sp_oss_batch_supported(const sp_codec* codec, int encode)
 {
-    return oss_lanes_for(codec, 1) != LANES_NONE && oss_lanes_for(codec, 0) != LANES_NONE;
+    return oss_lanes_for(codec, encode) != LANES_NONE;
 }
 
 /* The widest path this CPU, the caller and the codec allow. */

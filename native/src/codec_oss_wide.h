@@ -10,7 +10,7 @@
 #include "codec_internal.h"
 
 /* Largest N of the K = 2 wide encode: its grid 2(N - 1) stays below 2^50, where sp_grid_quantize
- * rounds in double (past it, in long double, which the vector lanes do not have). */
+ * rounds in double (past it, exactly in integers: sp_grid_round_pair, which no vector lane has yet). */
 #define SP_OSS_WIDE_MAX_N2_ENCODE ((uint64_t)1 << 49)
 
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole

@@ -67,9 +67,17 @@ def print_run(run):
         enc = mark(best[0], bars[0]) if oss else f"{best[0]:.3f}"
         dec = mark(best[1], bars[1]) if oss else f"{best[1]:.3f}"
         print(f"| {c['method']} | {c['influences']} | {c['budget']} | {c['bits']} | "
-              f"{'vector' if c['vector'] else 'scalar'} | {c['encode_vertices_per_s'] / 1e6:.1f} | {enc} | "
+              f"{path_name(c)} | {c['encode_vertices_per_s'] / 1e6:.1f} | {enc} | "
               f"{c['encode_ratio']:.3f} | {c['decode_vertices_per_s'] / 1e6:.1f} | {dec} | {c['decode_ratio']:.3f} |")
     print()
+
+
+def path_name(codec):
+    """'vector', 'scalar', or which direction has the vector path."""
+    encode, decode = codec["encode_vector"], codec["decode_vector"]
+    if encode == decode:
+        return "vector" if encode else "scalar"
+    return "vector decode" if decode else "vector encode"
 
 
 def main():

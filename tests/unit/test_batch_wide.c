@@ -209,7 +209,8 @@ static void path_coverage(const sp_codec* c, int encodes)
     for (size_t v = 0; v < 23; ++v) codes[v] = rng_next() % (c->max_code + 1);
     CHECK_MSG(sp_oss_decode_batch(c, codes, 23, w, widest) == expected, "K=%u N=%llu decode prefix", c->influences,
               (unsigned long long)c->n);
-    CHECK(sp_oss_batch_supported(c) == encodes);
+    CHECK(sp_oss_batch_supported(c, 1) == encodes);
+    CHECK(sp_oss_batch_supported(c, 0));
 }
 
 /* Weights the scalar rounding sends down its general path (negative, NaN, infinite, zero, not
