@@ -3,8 +3,7 @@
  * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
  * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
  * lanes, up to 64-bit codes. Both per ISA in codec_oss_batch_avx512.c and codec_oss_batch_avx2.c.
- * What no vector path takes (K = 2 encode past N = 2^49, whose exact integer rounding has no vector form yet) is left to
- * the scalar loop in codec.c.
+ * K = 2 encode past N = 2^49 runs sp_grid_round_pair's exact integer rounding in the wide lanes.
  */
 #include "codec_internal.h"
 #include "codec_oss_wide.h"
@@ -30,7 +29,7 @@ static oss_lanes oss_lanes_for(const sp_codec* codec, int encode)
     if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return LANES_NONE;
     uint64_t limit = k == 2 ? BATCH_MAX_N2 : (k == 3 ? BATCH_MAX_N3 : BATCH_MAX_N4);
     if (codec->n <= limit) return LANES_DOUBLE;
-    if (k == 2 && encode && codec->n > SP_OSS_WIDE_MAX_N2_ENCODE) return LANES_NONE;
+    (void)encode; /* every codec of K = 2..4 has both directions (K = 2 encode past 2^49: the exact pair rounding) */
     return LANES_WIDE;
 }
 

@@ -282,7 +282,9 @@ SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm512_mul_epu32(a, b); 
 SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b) { return _mm512_mullo_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_mul(a, b); }
 SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b) { return _mm512_cmplt_epu64_mask(a, b); }
-SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return _mm512_cmplt_epi64_mask(a, b); }
+SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm512_cmplt_epi64_mask(a, b); }
+SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
+SP_INLINE SIMD_FN uvec u_sllv(uvec a, uvec count) { return _mm512_sllv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
 SP_INLINE SIMD_FN vec v_from_u(uvec a) { return _mm512_cvtepu64_pd(a); }
@@ -293,6 +295,9 @@ SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
     *low = _mm512_cvtepu64_pd(u_and(a, u_splat(0xFFFFFFFFu)));
 }
 SP_INLINE SIMD_FN uvec u_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
+SP_INLINE SIMD_FN vec v_from_i_rounded(uvec a) { return _mm512_cvtepi64_pd(a); } /* rounded to nearest */
+SP_INLINE SIMD_FN uvec u_from_v_truncated(vec x) { return _mm512_cvttpd_epu64(x); }
+SP_INLINE SIMD_FN uvec i_from_v_small(vec x) { return _mm512_cvttpd_epi64(x); }
 
 /* K = 2 and 3 weights: codec_oss_simd.h's store (two-source permutes) serves. */
 SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)

@@ -1,17 +1,13 @@
 /*
  * The OSS batch paths for codes past the double lanes' exact range (internal): K = 3 past
- * N = 2^24, K = 4 past N = 3 * 2^15 (every width up to 64 bits), K = 2 decode past N = 2^48 and
- * its encode up to N = 2^49. The driver is codec_oss_wide_simd.h, the per-ISA files
+ * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 past N = 2^48 (every width up to 64 bits; K = 2 encode
+ * past N = 2^49 in sp_grid_round_pair's exact integer form). The driver is codec_oss_wide_simd.h, the per-ISA files
  * codec_oss_batch_avx2.c and codec_oss_batch_avx512.c; codec_oss_batch.c dispatches.
  */
 #ifndef SKINPACK_CODEC_OSS_WIDE_H
 #define SKINPACK_CODEC_OSS_WIDE_H
 
 #include "codec_internal.h"
-
-/* Largest N of the K = 2 wide encode: its grid 2(N - 1) stays below 2^50, where sp_grid_quantize
- * rounds in double (past it, exactly in integers: sp_grid_round_pair, which no vector lane has yet). */
-#define SP_OSS_WIDE_MAX_N2_ENCODE ((uint64_t)1 << 49)
 
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole
  * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and

@@ -197,10 +197,70 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
 
 DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
 
+/* K = 2 on grids s >= SP_GRID_DOUBLE_LIMIT: sp_grid_round_pair's portable form lane by lane, on
+ * sp_grid_pair_parts of the two floats' bits (one 64-bit lane a vertex: weight 0 low, weight 1
+ * high). Writes the codes q[1] and counts; returns the lanes that are not plain or have a gap
+ * past SP_GRID_PAIR_GAP (garbage there), as bits, for the scalar redo. */
+SP_INLINE SIMD_FN unsigned wide_pair_block(const wide_codec* c, const float* weights, uint64_t* codes,
+                                           uint8_t* significant)
+{
+    uvec bits = u_load((const uint64_t*)(const void*)weights), low32 = u_splat(0xFFFFFFFFu);
+    uvec bits0 = u_and(bits, low32), bits1 = u_srl(bits, 32), magnitude = u_splat(0x7FFFFFFFu);
+    uvec magnitude0 = u_and(bits0, magnitude), magnitude1 = u_and(bits1, magnitude);
+    umask ties_up = u_lt_small(magnitude0, magnitude1);
+    uvec small = u_select(ties_up, magnitude0, magnitude1), large = u_select(ties_up, magnitude1, magnitude0);
+    uvec small_exponent = u_srl(small, 23), large_exponent = u_srl(large, 23), zero = u_splat(0), one = u_splat(1);
+    uvec significand = u_splat(0x7FFFFFu), hidden = u_splat(0x800000u);
+    umask small_normal = u_lt_small(zero, small_exponent), large_normal = u_lt_small(zero, large_exponent);
+    uvec small_part = u_add(u_and(small, significand), u_select(small_normal, hidden, zero));
+    uvec large_part = u_add(u_and(large, significand), u_select(large_normal, hidden, zero));
+    small_exponent = u_select(small_normal, small_exponent, one), large_exponent = u_select(large_normal, large_exponent, one);
+    uvec gap = u_select(u_lt_small(zero, small), u_sub(large_exponent, small_exponent), zero);
+    uvec sign_only = u_splat(0x80000001u);
+    unsigned plain = um_bits(u_lt_small(bits0, sign_only)) & um_bits(u_lt_small(bits1, sign_only)) &
+                     um_bits(u_lt_small(large, u_splat(0x7F800000u))) & um_bits(u_lt_small(zero, large)) &
+                     um_bits(u_lt_small(gap, u_splat(SP_GRID_PAIR_GAP + 1)));
+    /* sp_grid_round_pair's #else branch: estimate, exact remainder mod 2^64, one correction, +-1 */
+    uvec sum = u_add(u_sllv(large_part, gap), small_part);
+    vec inverse = v_div(v_splat(1.0), v_from_u_rounded(sum));
+    vec estimate = v_mul(v_mul(v_from_u(small_part), v_splat(c->scale)), inverse);
+    uvec whole = u_from_v_truncated(v_min(estimate, v_splat(0x1.fffffffffffffp62)));
+    uvec rest = u_sub(u_mul_u32(u_splat(c->scale_bits), small_part), u_mul(whole, sum));
+    uvec steps = i_from_v_small(v_trunc(v_mul(v_from_i_rounded(rest), inverse)));
+    whole = u_add(whole, steps);
+    rest = u_sub(rest, u_mul(steps, sum));
+    uvec twice = u_add(u_add(rest, rest), u_select(ties_up, one, zero));
+    umask up = u_lt_signed(sum, twice), down = u_lt_signed(twice, u_add(u_sub(zero, sum), one)); /* twice <= -D */
+    uvec nearest = u_select(up, u_add(whole, one), u_select(down, u_sub(whole, one), whole));
+    u_store(codes, nearest);
+    if (significant) {
+        vec q[2] = {v_zero(), v_from_u_rounded(nearest)}; /* only q[1] > 0 counts: nonzero lanes round above 0 */
+        store_significant(q, 2, significant);
+    }
+    return ~plain & ((1u << BLOCK) - 1);
+}
+
+/* `blocks` blocks of K = 2 past the double rounding, then the scalar redo of the missed lanes. */
+SP_INLINE SIMD_FN void wide_pair_chunk(const sp_codec* codec, const void* constants, const float* weights,
+                                       size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
+                                       const simd_layout* layout)
+{
+    unsigned missed[ENCODE_CHUNK];
+    (void)layout;
+    for (size_t b = 0; b < blocks; ++b)
+        missed[b] = wide_pair_block((const wide_codec*)constants, weights + b * BLOCK * 2, codes + b * BLOCK,
+                                    significant ? significant + b * BLOCK : NULL);
+    redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
+}
+
+DEFINE_ENCODE_WALK(wide_pair_walk, wide_pair_chunk)
+
 SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
     wide_codec c = wide_codec_for(codec);
+    if (codec->influences == 2 && codec->scale >= SP_GRID_DOUBLE_LIMIT)
+        return wide_pair_walk(codec, &c, weights, count, codes, significant, 2);
     RETURN_FOR_EACH_K(codec, wide_encode_walk, codec, &c, weights, count, codes, significant)
 }
 

@@ -1,11 +1,12 @@
 /*
  * The wide OSS vector paths (codec_oss_wide_simd.h: 64-bit integer lanes for K = 3 past
- * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 decode past N = 2^48) against the scalar code, bit
+ * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 past N = 2^48) against the scalar code, bit
  * for bit, once per vector path the CPU has: codes around every layer start (K = 4) and around
  * row starts (every row of sampled layers; for K = 3 every row just past the double lanes, and
  * the first, last and sampled rows of wider codes, where the root arguments stop being exact),
  * the last codes, random codes and weights from 46 to 64 bits, odd weights, counts and
- * alignments, and invalid codes, which stop the batch where the scalar code stops.
+ * alignments, invalid codes, which stop the batch where the scalar code stops, and for K = 2
+ * past N = 2^49 (the exact pair rounding) adversarial pairs at 51..63 bits.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -248,6 +249,48 @@ static void counts_and_alignment(const sp_codec* c)
     CHECK(sp_decode_weights_batch_isa(c, NULL, 0, NULL, NULL, widest) == SP_OK);
 }
 
+/* K = 2 pairs for the lanes' exact rounding (grids past 2^50): every exponent gap 0..70 with
+ * random significands in both slot orders, denormals, zeros, equal weights, the edges of the
+ * plain test (-0, the smallest negative, the largest float, infinity, NaN), near ties (the
+ * smaller weight picked so that x = s small / D is near m + 1/2, as near as a float allows) and
+ * exact ties +-1 step. */
+static void adversarial_pairs(const sp_codec* c)
+{
+    static const uint32_t edges[] = {0x00000000u, 0x80000000u, 0x80000001u, 0x00000001u, 0x007FFFFFu,
+                                     0x00800000u, 0x7F7FFFFFu, 0x7F800000u, 0x7FC00000u, 0x3F800000u};
+    size_t count = 60000, ties = 0;
+    uint32_t tie[64][2]; /* B < 2^k with s B = 2^(k-1) mod 2^k: x = s B / 2^k is exactly m + 1/2 */
+    for (uint32_t k = 8; k <= 16 && ties < 64; ++k)
+        for (uint64_t b = 1; b < ((uint64_t)1 << k) && ties < 64; ++b)
+            if (((c->scale * b) & (((uint64_t)1 << k) - 1)) == (uint64_t)1 << (k - 1)) tie[ties][0] = (uint32_t)b, tie[ties++][1] = k;
+    float* w = malloc(count * 2 * sizeof(float));
+    for (size_t v = 0; v < count; ++v) {
+        uint32_t gap = (uint32_t)(rng_next() % 71), kind = (uint32_t)(rng_next() % 7), bits[2];
+        int exponent = -(int)(rng_next() % 60);
+        float large = ldexpf((float)((rng_next() & 0x7FFFFF) | 0x800000), exponent - 23);
+        float small = ldexpf((float)((rng_next() & 0x7FFFFF) | 0x800000), exponent - 23 - (int)gap);
+        if (kind == 1) small = ldexpf((float)(rng_next() % 0x800000), -149);
+        if (kind == 2) small = v % 2 ? 0.0f : large;
+        if (kind == 3) { /* near a tie: D ~ large, x = s small / D, small moved so x is m + 1/2 */
+            long double d = (long double)large, x = (long double)c->scale * small / (d + small);
+            long double target = floorl(x) + 0.5L, b = target * d / ((long double)c->scale - target);
+            small = (float)b;
+        }
+        if (kind == 5 && ties) { /* an exact tie, or 1/2^k off it (D = 2^(exponent - k) exactly) */
+            const uint32_t* t = tie[rng_next() % ties];
+            int64_t b = (int64_t)t[0] + (int64_t)(rng_next() % 3) - 1;
+            small = ldexpf((float)b, exponent - (int)t[1]);
+            large = ldexpf((float)(((int64_t)1 << t[1]) - b), exponent - (int)t[1]);
+        }
+        memcpy(&bits[0], &large, 4), memcpy(&bits[1], &small, 4);
+        if (kind == 4) bits[rng_next() % 2] = edges[rng_next() % (sizeof(edges) / sizeof(edges[0]))];
+        int swap = (int)(rng_next() % 2);
+        memcpy(&w[v * 2 + swap], &bits[0], 4), memcpy(&w[v * 2 + 1 - swap], &bits[1], 4);
+    }
+    compare_encode(c, w, count, "adversarial pair encode");
+    free(w);
+}
+
 static void check_codec(const sp_codec* c, int encodes)
 {
     counts_and_alignment(c);
@@ -273,10 +316,16 @@ int main(void)
         sp_codec edges[] = {oss_n(3, ((uint64_t)1 << 24) + 1), oss_n(4, ((uint64_t)3 << 15) + 1),
                             oss_n(2, ((uint64_t)1 << 48) + 1), oss_n(2, (uint64_t)1 << 49)};
         for (size_t e = 0; e < sizeof(edges) / sizeof(edges[0]); ++e) check_codec(&edges[e], 1);
+        /* K = 2 past 2^49: the exact pair rounding in the lanes */
         sp_codec k2_52 = oss_bits(2, 52), k2_64 = oss_bits(2, 64), k2_past = oss_n(2, ((uint64_t)1 << 49) + 1);
-        check_codec(&k2_52, 0); /* K = 2 encode past 2^49 rounds in long double: scalar */
-        check_codec(&k2_64, 0);
-        check_codec(&k2_past, 0);
+        check_codec(&k2_52, 1);
+        check_codec(&k2_64, 1);
+        check_codec(&k2_past, 1);
+        static const uint32_t pair_widths[] = {51, 52, 56, 60, 63};
+        for (size_t i = 0; i < sizeof(pair_widths) / sizeof(pair_widths[0]); ++i) {
+            sp_codec c = oss_bits(2, pair_widths[i]);
+            adversarial_pairs(&c);
+        }
         every_row_start();
     }
     return check_report("test_batch_wide");
