@@ -24,8 +24,11 @@
  *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates), u_srlv
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
  *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
- *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_select(m, a, b) = m ? a : b, um_bits (lanes as bits)
+ *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_lt_signed (signed compare),
+ *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits), u_sllv (variable left shift)
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
+ *   v_from_i_rounded (signed, likewise), u_from_v_truncated (doubles in [0, 2^63), as C
+ *   truncates), i_from_v_small (integral doubles of magnitude below 2^51, signed),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
  *   in [0, 2^52))
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
