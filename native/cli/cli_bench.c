@@ -284,8 +284,8 @@ int skinpack_cmd_bench(int argc, char** argv)
                 bench_rate enc, dec;
                 if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
                 codec_rates(&o, &b, &codec, &enc, &dec);
-                int vector_encode = m == SP_METHOD_OSS && isa > SP_ISA_SCALAR && sp_oss_batch_supported(&codec, 1);
-                int vector_decode = m == SP_METHOD_OSS && isa > SP_ISA_SCALAR && sp_oss_batch_supported(&codec, 0);
+                int vector_encode = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, 1, isa);
+                int vector_decode = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, 0, isa);
                 if (o.json)
                     printf("%s{\"method\": \"%s\", \"influences\": %u, \"budget\": %u, \"bits\": %u, "
                            "\"encode_vector\": %s, \"decode_vector\": %s, "

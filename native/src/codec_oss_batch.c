@@ -33,17 +33,21 @@ static oss_lanes oss_lanes_for(const sp_codec* codec, int encode)
     return LANES_WIDE;
 }
 
-int sp_oss_batch_supported(const sp_codec* codec, int encode)
-{
-    return oss_lanes_for(codec, encode) != LANES_NONE;
-}
-
 /* The widest path this CPU, the caller and the codec allow. */
 static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
 {
     if (lanes == LANES_NONE) return SP_ISA_SCALAR;
     sp_isa cpu = sp_cpu_isa();
     return cpu < widest ? cpu : widest;
+}
+
+int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest)
+{
+    oss_lanes lanes = oss_lanes_for(codec, encode);
+    sp_isa isa = batch_isa(lanes, widest);
+    if (encode && lanes == LANES_WIDE && codec->influences == 2 && codec->scale >= SP_GRID_DOUBLE_LIMIT)
+        return isa >= SP_OSS_WIDE_PAIR_ISA;
+    return isa > SP_ISA_SCALAR;
 }
 
 /* AVX-512 takes blocks of 8, AVX2 what is left in blocks of 4 (the tail, or the rest after a

@@ -331,6 +331,7 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root zf)
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx2
 
 #define WIDE_ROOT_NEWTON 1 /* its cube root is ~4e-8 off in places */
+#define WIDE_PAIR_LANES 0  /* K = 2 past 2^50 grids: 4 lanes ran 7.3 ns a vertex, the scalar DIV 5.4 */
 
 typedef __m256i uvec;
 typedef __m256i umask; /* all-ones lanes */
@@ -358,7 +359,6 @@ SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b)
 }
 SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm256_cmpgt_epi64(b, a); }
 SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
-SP_INLINE SIMD_FN uvec u_sllv(uvec a, uvec count) { return _mm256_sllv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm256_blendv_epi8(b, a, m); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
 
@@ -391,31 +391,6 @@ SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a)
     uvec high = _mm256_or_si256(u_srl(a, 32), _mm256_castpd_si256(v_splat(0x1p84)));
     uvec low = _mm256_blend_epi32(a, _mm256_castpd_si256(v_splat(0x1p52)), 0xAA);
     return v_add(v_sub(_mm256_castsi256_pd(high), v_splat(0x1p84 + 0x1p52)), _mm256_castsi256_pd(low));
-}
-
-/* Signed lanes, rounded to nearest as C converts: the magnitude's conversion, negated (rounding
- * to nearest is symmetric). */
-SP_INLINE SIMD_FN vec v_from_i_rounded(uvec a)
-{
-    umask negative = u_lt_signed(a, _mm256_setzero_si256());
-    vec magnitude = v_from_u_rounded(u_select(negative, u_sub(_mm256_setzero_si256(), a), a));
-    return _mm256_xor_pd(magnitude, _mm256_and_pd(_mm256_castsi256_pd(negative), v_splat(-0.0)));
-}
-
-/* Doubles in [0, 2^63), truncated as C converts: the integral part's halves below and above 2^32
- * (both exact: the low one is the exact difference of two doubles, an integer below 2^32). */
-SP_INLINE SIMD_FN uvec u_from_v_truncated(vec x)
-{
-    vec whole = v_trunc(x), high = v_floor(v_mul(whole, v_splat(0x1p-32)));
-    vec low = v_fnmadd(high, v_splat(0x1p32), whole);
-    return u_add(u_sll(u_from_v(high), 32), u_from_v(low));
-}
-
-/* Integral doubles of magnitude below 2^51 to signed lanes: through the mantissa of 1.5 2^52. */
-SP_INLINE SIMD_FN uvec i_from_v_small(vec x)
-{
-    vec magic = v_splat(0x1.8p52);
-    return u_sub(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic));
 }
 
 /* K = 2 weights, as sp_grid_to_weights rounds them, stored as four vertices by one interleave

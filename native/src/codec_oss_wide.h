@@ -9,6 +9,10 @@
 
 #include "codec_internal.h"
 
+/* The narrowest ISA whose wide lanes take K = 2 encode on grids past 2^50 (WIDE_PAIR_LANES in
+ * the primitives headers): AVX2's four lanes were slower than the scalar code's 128/64 division. */
+#define SP_OSS_WIDE_PAIR_ISA SP_ISA_AVX512
+
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole
  * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and
  * sp_oss_decode_one; return how many leading vertices were done. Decode stops before a block

@@ -25,15 +25,17 @@
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
  *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
  *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_lt_signed (signed compare),
- *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits), u_sllv (variable left shift)
+ *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits)
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
- *   v_from_i_rounded (signed, likewise), u_from_v_truncated (doubles in [0, 2^63), as C
- *   truncates), i_from_v_small (integral doubles of magnitude below 2^51, signed),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
  *   in [0, 2^52))
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
  *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
+ *   WIDE_PAIR_LANES    1: K = 2 encode past 2^50 grids in lanes (SP_OSS_WIDE_PAIR_ISA), which
+ *                      then also needs u_sllv (variable left shift), v_from_i_rounded (signed,
+ *                      rounded as C converts), u_from_v_truncated (doubles in [0, 2^63), as C
+ *                      truncates) and i_from_v_small (integral doubles below 2^51, signed)
  * and WIDE_NAME(name), the entry points' names.
  */
 
@@ -200,6 +202,7 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
 
 DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
 
+#if WIDE_PAIR_LANES /* where the lanes beat the scalar code's DIV (the primitives header says) */
 /* K = 2 on grids s >= SP_GRID_DOUBLE_LIMIT: sp_grid_round_pair's portable form lane by lane, on
  * sp_grid_pair_parts of the two floats' bits (one 64-bit lane a vertex: weight 0 low, weight 1
  * high). Writes the codes q[1] and counts; returns the lanes that are not plain or have a gap
@@ -257,13 +260,19 @@ SP_INLINE SIMD_FN void wide_pair_chunk(const sp_codec* codec, const void* consta
 }
 
 DEFINE_ENCODE_WALK(wide_pair_walk, wide_pair_chunk)
+#endif
+
 
 SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
     wide_codec c = wide_codec_for(codec);
     if (codec->influences == 2 && codec->scale >= SP_GRID_DOUBLE_LIMIT)
+#if WIDE_PAIR_LANES
         return wide_pair_walk(codec, &c, weights, count, codes, significant, 2);
+#else
+        return 0; /* the scalar code's 128/64 division is faster than these lanes */
+#endif
     RETURN_FOR_EACH_K(codec, wide_encode_walk, codec, &c, weights, count, codes, significant)
 }
 
