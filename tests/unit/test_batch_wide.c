@@ -17,64 +17,13 @@
 #include "check.h"
 #include "skinpack.h"
 
-static sp_isa widest = SP_ISA_AVX512;
+#include "batch_compare.h"
 
 static sp_codec oss_bits(uint32_t k, uint32_t bits)
 {
     sp_codec c;
     CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, bits, &c) == SP_OK);
     return c;
-}
-
-static sp_codec oss_n(uint32_t k, uint64_t n)
-{
-    sp_codec c;
-    CHECK(sp_codec_from_params(SP_METHOD_OSS, k, n, NULL, &c) == SP_OK);
-    return c;
-}
-
-/* Decodes codes with the vector path under test and with the scalar path only (the reference,
- * spot-checked against sp_decode_weights), comparing the floats bit for bit. */
-static void compare_decode(const sp_codec* c, const uint64_t* codes, size_t count, const char* what)
-{
-    uint32_t k = c->influences;
-    float* w = malloc((count * k + 1) * sizeof(float));
-    float* ref = malloc((count * k + 1) * sizeof(float));
-    float one[SP_MAX_INFLUENCES];
-    int before = check_failures;
-    CHECK(sp_decode_weights_batch_isa(c, codes, count, w, NULL, widest) == SP_OK);
-    CHECK(sp_decode_weights_batch_isa(c, codes, count, ref, NULL, SP_ISA_SCALAR) == SP_OK);
-    for (size_t v = 0; v < count && check_failures - before < 5; ++v) {
-        CHECK_MSG(memcmp(w + v * k, ref + v * k, k * sizeof(float)) == 0, "%s K=%u N=%llu code %llu: %.9g %.9g vs %.9g %.9g",
-                  what, k, (unsigned long long)c->n, (unsigned long long)codes[v], w[v * k], w[v * k + 1], ref[v * k],
-                  ref[v * k + 1]);
-        if (v % 997 == 0) {
-            sp_decode_weights(c, codes[v], one);
-            CHECK(memcmp(one, ref + v * k, k * sizeof(float)) == 0);
-        }
-    }
-    free(w), free(ref);
-}
-
-/* Encodes with the vector path under test and vertex by vertex (one-vertex batches are scalar):
- * codes and significant counts, also without the counts. */
-static void compare_encode(const sp_codec* c, const float* w, size_t count, const char* what)
-{
-    uint32_t k = c->influences;
-    uint64_t* codes = malloc((count + 1) * sizeof(uint64_t));
-    uint64_t* bare = malloc((count + 1) * sizeof(uint64_t));
-    uint8_t* sig = malloc(count + 1);
-    int before = check_failures;
-    CHECK(sp_encode_weights_batch_isa(c, w, count, codes, sig, widest) == SP_OK);
-    CHECK(sp_encode_weights_batch_isa(c, w, count, bare, NULL, widest) == SP_OK);
-    for (size_t v = 0; v < count && check_failures - before < 5; ++v) {
-        uint64_t ref;
-        uint8_t ref_sig;
-        CHECK(sp_encode_weights_batch_isa(c, w + v * k, 1, &ref, &ref_sig, SP_ISA_SCALAR) == SP_OK);
-        CHECK_MSG(codes[v] == ref && bare[v] == ref && sig[v] == ref_sig, "%s K=%u N=%llu vertex %zu: %llu vs %llu",
-                  what, k, (unsigned long long)c->n, v, (unsigned long long)codes[v], (unsigned long long)ref);
-    }
-    free(codes), free(bare), free(sig);
 }
 
 /* The codes start - 2 .. start + 1 of a base, those in range. */
@@ -127,7 +76,7 @@ static void boundaries(const sp_codec* c)
 /* K = 3 just past the double lanes (N = 2^24 + 1): codes around every row start, in batches. */
 static void every_row_start(void)
 {
-    sp_codec c = oss_n(3, ((uint64_t)1 << 24) + 1);
+    sp_codec c = oss(3, ((uint64_t)1 << 24) + 1);
     uint64_t rows = (2 * c.n + 1) / 3, batch = 1 << 18;
     uint64_t* codes = malloc(batch * 4 * sizeof(uint64_t));
     for (uint64_t first = 0; first <= rows; first += batch) {
@@ -317,11 +266,11 @@ int main(void)
                 if (c.n > (k == 3 ? (uint64_t)1 << 24 : (uint64_t)3 << 15)) check_codec(&c);
             }
         /* just past the double lanes, and the largest N of each K */
-        sp_codec edges[] = {oss_n(3, ((uint64_t)1 << 24) + 1), oss_n(4, ((uint64_t)3 << 15) + 1),
-                            oss_n(2, ((uint64_t)1 << 48) + 1), oss_n(2, (uint64_t)1 << 49)};
+        sp_codec edges[] = {oss(3, ((uint64_t)1 << 24) + 1), oss(4, ((uint64_t)3 << 15) + 1),
+                            oss(2, ((uint64_t)1 << 48) + 1), oss(2, (uint64_t)1 << 49)};
         for (size_t e = 0; e < sizeof(edges) / sizeof(edges[0]); ++e) check_codec(&edges[e]);
         /* K = 2 past 2^49: the exact pair rounding in the lanes */
-        sp_codec k2_52 = oss_bits(2, 52), k2_64 = oss_bits(2, 64), k2_past = oss_n(2, ((uint64_t)1 << 49) + 1);
+        sp_codec k2_52 = oss_bits(2, 52), k2_64 = oss_bits(2, 64), k2_past = oss(2, ((uint64_t)1 << 49) + 1);
         check_codec(&k2_52);
         check_codec(&k2_64);
         check_codec(&k2_past);
