@@ -129,10 +129,10 @@ SP_INLINE sp_grid_pair sp_grid_pair_parts(const float* weights)
  * gap) + 2) D < 2^62, so modulo 2^64 is exact), f corrected by r / D in double (within 2^-35 of
  * the truth, so the remainder is then below 1.01 D) and a last +-1 from the exact remainder's
  * comparison with D/2.
- * grid is s as a double (a loop's constant). Returns 0, q untouched, for input that is not plain
- * or has a gap past SP_GRID_PAIR_GAP: the general rounding decides those.
+ * Returns 0, q untouched, for input that is not plain or has a gap past SP_GRID_PAIR_GAP: the
+ * general rounding decides those.
  */
-SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, double grid, uint64_t* q)
+SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, uint64_t* q)
 {
     sp_grid_pair pair = sp_grid_pair_parts(weights);
     if (!pair.plain || pair.gap > SP_GRID_PAIR_GAP) return 0;
@@ -140,9 +140,8 @@ SP_INLINE int sp_grid_round_pair(const float* weights, uint64_t s, double grid, 
 #if SP_NARROW_DIVIDE
     uint64_t rest, whole = sp_u128_divide_narrow(sp_u128_mul_u64(sp_u128_from(s), pair.small), sum, &rest);
     nearest = whole + (2 * rest + pair.ties_up > sum);
-    (void)grid;
 #else
-    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * grid * inverse;
+    double inverse = 1.0 / (double)(int64_t)sum, estimate = (double)(int64_t)pair.small * (double)s * inverse;
     estimate = estimate < 0x1.fffffffffffffp62 ? estimate : 0x1.fffffffffffffp62; /* (int64_t) stays defined */
     int64_t whole = (int64_t)estimate;
     int64_t rest = (int64_t)(s * pair.small - (uint64_t)whole * sum);
@@ -165,7 +164,7 @@ SP_INLINE void sp_grid_quantize(const float* weights, uint32_t k, uint64_t s, ui
     k = k < SP_MAX_INFLUENCES ? k : SP_MAX_INFLUENCES; /* the bound the unrolled loops may rely on */
     if (s < SP_GRID_DOUBLE_LIMIT) {
         if (sp_grid_round(weights, k, s, sp_grid_scale(weights, k, (double)s), q)) return;
-    } else if (k == 2 && sp_grid_round_pair(weights, s, (double)s, q))
+    } else if (k == 2 && sp_grid_round_pair(weights, s, q))
         return;
     sp_grid_quantize_general(weights, k, s, q);
 }

@@ -23,14 +23,13 @@
  * in-layer indices stay below 2^47 in double). */
 typedef enum { LANES_NONE, LANES_DOUBLE, LANES_WIDE } oss_lanes;
 
-static oss_lanes oss_lanes_for(const sp_codec* codec, int encode)
+static oss_lanes oss_lanes_for(const sp_codec* codec)
 {
     uint32_t k = codec->influences;
     if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return LANES_NONE;
     uint64_t limit = k == 2 ? BATCH_MAX_N2 : (k == 3 ? BATCH_MAX_N3 : BATCH_MAX_N4);
-    if (codec->n <= limit) return LANES_DOUBLE;
-    (void)encode; /* every codec of K = 2..4 has both directions (K = 2 encode past 2^49: the exact pair rounding) */
-    return LANES_WIDE;
+    /* the same lanes both ways (K = 2 encode past 2^49: the exact pair rounding) */
+    return codec->n <= limit ? LANES_DOUBLE : LANES_WIDE;
 }
 
 /* The widest path this CPU, the caller and the codec allow. */
@@ -43,7 +42,7 @@ static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
 
 int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest)
 {
-    oss_lanes lanes = oss_lanes_for(codec, encode);
+    oss_lanes lanes = oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
     if (encode && lanes == LANES_WIDE && codec->influences == 2 && codec->scale >= SP_GRID_DOUBLE_LIMIT)
         return isa >= SP_OSS_WIDE_PAIR_ISA;
@@ -58,7 +57,7 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 {
     size_t done = 0;
 #if SP_X86_SIMD
-    oss_lanes lanes = oss_lanes_for(codec, 1);
+    oss_lanes lanes = oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
     sp_oss_encode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
     sp_oss_encode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
@@ -76,7 +75,7 @@ size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t 
 {
     size_t done = 0;
 #if SP_X86_SIMD
-    oss_lanes lanes = oss_lanes_for(codec, 0);
+    oss_lanes lanes = oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
     sp_oss_decode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
     sp_oss_decode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;

@@ -148,10 +148,8 @@ SP_INLINE SIMD_FN vec layer_base(double n, vec k)
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
-/* sp_grid_quantize's s / sum of the weights: a stage of its own, as the division ends a chain.
- * The scalar sums from 0 + w0, which differs from w0 only for w0 = -0, and then only if all
- * weights are -0 does the sum: scale = -inf instead of +inf, and every x NaN either way (a
- * lane the rounding redoes). */
+/* sp_grid_scale in lanes (the same sum from w0, the same division): a stage of its own, as the
+ * division ends a chain. */
 SP_INLINE SIMD_FN vec quantize_scale(const vec* w, uint32_t k, double s)
 {
     vec sum = w[0];

@@ -262,7 +262,6 @@ SP_INLINE SIMD_FN void wide_pair_chunk(const sp_codec* codec, const void* consta
 DEFINE_ENCODE_WALK(wide_pair_walk, wide_pair_chunk)
 #endif
 
-
 SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                                  uint8_t* significant)
 {
