@@ -16,6 +16,8 @@
 SP_FP_CONTRACT_OFF
 #define SIMD_FN SP_TARGET("avx2,fma")
 #define SIMD_NAME(name) sp_oss_##name##_avx2
+#define SIMD_ISA 1 /* SP_ISA_AVX2, for the preprocessor */
+_Static_assert(SIMD_ISA == SP_ISA_AVX2, "SIMD_ISA is this file's sp_isa");
 #define BLOCK 4
 #define ENCODE_CHUNK 16 /* K = 3 encode ~3% faster than 8 */
 #define ENCODE_FUSED 0 /* in one stage K = 4 encode spills and runs ~25% slower */
@@ -331,7 +333,6 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root zf)
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx2
 
 #define WIDE_ROOT_NEWTON 1 /* its cube root is ~4e-8 off in places */
-#define WIDE_PAIR_LANES 0  /* K = 2 past 2^50 grids: 4 lanes ran 7.3 ns a vertex, the scalar DIV 5.4 */
 
 typedef __m256i uvec;
 typedef __m256i umask; /* all-ones lanes */

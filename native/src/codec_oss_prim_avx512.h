@@ -15,6 +15,8 @@
 SP_FP_CONTRACT_OFF /* avx512f implies fma */
 #define SIMD_FN SP_TARGET("avx512f,avx512dq,avx512vl")
 #define SIMD_NAME(name) sp_oss_##name##_avx512
+#define SIMD_ISA 2 /* SP_ISA_AVX512, for the preprocessor */
+_Static_assert(SIMD_ISA == SP_ISA_AVX512, "SIMD_ISA is this file's sp_isa");
 #define BLOCK 8
 #define ENCODE_CHUNK 16 /* blocks per stage: on Zen 5, 8 is ~3% slower for K = 3, 4, 32 no faster */
 #define DECODE_CHUNK 16 /* on Zen 5, 8 is ~5% slower for K = 3, 4 decode (4 was ~20% slower on Zen 4) */
@@ -265,7 +267,6 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root yf)
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx512
 
 #define WIDE_ROOT_NEWTON 0 /* its root (a double Newton step) is good to far below half a layer */
-#define WIDE_PAIR_LANES 1  /* K = 2 past 2^50 grids: 1.9 ns a vertex against the scalar DIV's 5.4 */
 
 typedef __m512i uvec;
 typedef __mmask8 umask;

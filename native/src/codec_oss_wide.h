@@ -10,9 +10,12 @@
 
 #include "codec_internal.h"
 
-/* The narrowest ISA whose wide lanes take K = 2 encode on grids past 2^50 (WIDE_PAIR_LANES in
- * the primitives headers): AVX2's four lanes were slower than the scalar code's 128/64 division. */
-#define SP_OSS_WIDE_PAIR_ISA SP_ISA_AVX512
+/* The narrowest ISA whose wide lanes take K = 2 encode on grids past 2^50, as a number for the
+ * preprocessor (the sp_isa value; the drivers compare it with their SIMD_ISA): AVX-512's lanes
+ * ran 1.9 ns a vertex, AVX2's four 7.3, slower than the scalar code's 128/64 division (5.4). */
+#define SP_OSS_WIDE_PAIR_ISA_VALUE 2
+#define SP_OSS_WIDE_PAIR_ISA ((sp_isa)SP_OSS_WIDE_PAIR_ISA_VALUE)
+_Static_assert(SP_OSS_WIDE_PAIR_ISA == SP_ISA_AVX512, "SP_OSS_WIDE_PAIR_ISA_VALUE is AVX-512's sp_isa");
 
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole
  * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and

@@ -32,10 +32,11 @@
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
  *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
- *   WIDE_PAIR_LANES    1: K = 2 encode past 2^50 grids in lanes (SP_OSS_WIDE_PAIR_ISA), which
- *                      then also needs u_sllv (variable left shift), v_from_i_rounded (signed,
- *                      rounded as C converts), u_from_v_truncated (doubles in [0, 2^63), as C
- *                      truncates) and i_from_v_small (integral doubles below 2^51, signed)
+ *   SIMD_ISA           the file's sp_isa as a number; from SP_OSS_WIDE_PAIR_ISA_VALUE on, K = 2
+ *                      encode past 2^50 grids runs in lanes, which then also needs u_sllv
+ *                      (variable left shift), v_from_i_rounded (signed, rounded as C converts),
+ *                      u_from_v_truncated (doubles in [0, 2^63), as C truncates) and
+ *                      i_from_v_small (integral doubles below 2^51, signed)
  * and WIDE_NAME(name), the entry points' names.
  */
 
@@ -202,7 +203,9 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
 
 DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
 
-#if WIDE_PAIR_LANES /* where the lanes beat the scalar code's DIV (the primitives header says) */
+/* K = 2 encode past 2^50 grids in lanes only where they beat the scalar code's division. */
+#define WIDE_PAIR_LANES (SIMD_ISA >= SP_OSS_WIDE_PAIR_ISA_VALUE)
+#if WIDE_PAIR_LANES
 /* K = 2 on grids s >= SP_GRID_DOUBLE_LIMIT: sp_grid_round_pair's portable form lane by lane, on
  * sp_grid_pair_parts of the two floats' bits (one 64-bit lane a vertex: weight 0 low, weight 1
  * high). Writes the codes q[1] and counts; returns the lanes that are not plain or have a gap
