@@ -128,6 +128,8 @@ size_t sp_meshlet_plan_scratch_bound(size_t triangle_count);
 void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count);
 /* Records the open meshlet (if it has triangles) as the plan's next one and empties it. */
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
+/* qsort order of uint64_t keys, ascending. */
+int sp_meshlet_compare_u64(const void* x, const void* y);
 /* Group b absorbs group a (a is marked merged; the caller checked every limit). */
 void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a);
 /* meshlets_parts.c: closes every connected part of at least max_vertices / 8 vertices that fits
