@@ -277,11 +277,11 @@ void sp_meshlet_plan_pack(sp_meshlet_context* ctx, sp_meshlet_plan* plan, unsign
     collect_pieces(&p, ctx, plan, keys);
     if (p.piece_count < 2)
         return;
-    size_t count_first = pack_greedy(&p, 0);
-    uint32_t count_first_bins = p.bin_count;
     size_t joints_first = pack_greedy(&p, 1);
-    if (count_first_bins < p.bin_count || (count_first_bins == p.bin_count && count_first <= joints_first))
-        pack_greedy(&p, 0); /* the count-first run again: it is the one kept */
+    uint32_t joints_first_bins = p.bin_count;
+    size_t count_first = pack_greedy(&p, 0); /* last: kept on ties, then with no rerun */
+    if (joints_first_bins < p.bin_count || (joints_first_bins == p.bin_count && joints_first < count_first))
+        pack_greedy(&p, 1); /* the joints-first run again: it is the one kept */
     if (p.piece_count <= SEARCH_PIECES)
         pack_search(&p);
     apply_bins(&p, plan);
