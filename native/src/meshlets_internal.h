@@ -128,19 +128,24 @@ size_t sp_meshlet_plan_scratch_bound(size_t triangle_count);
 void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t triangle_count);
 /* Records the open meshlet (if it has triangles) as the plan's next one and empties it. */
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
+/* qsort order of uint64_t keys, ascending. */
+int sp_meshlet_compare_u64(const void* x, const void* y);
 /* Group b absorbs group a (a is marked merged; the caller checked every limit). */
 void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a);
-/* meshlets_parts.c: closes every connected part of at least max_vertices / 8 vertices that fits
- * one meshlet whole (palette cap included) as a meshlet of the plan and sets taken[t] = 1 for its triangles; returns how many
- * triangles it took (adjacency_offset: vertex_count + 1 entries, as the skin builder keeps it). */
+/* meshlets_parts.c: scratch bytes for sp_meshlet_plan_close_parts. */
 size_t sp_meshlet_parts_scratch_bound(size_t triangle_count, size_t vertex_count);
+/* Closes every connected part of at least max_vertices / 8 vertices that fits one meshlet whole
+ * (palette cap included) as a meshlet of the plan and sets taken[t] = 1 for its triangles;
+ * returns how many triangles it took (adjacency_offset: vertex_count + 1 entries, as the skin
+ * builder keeps it). */
 size_t sp_meshlet_plan_close_parts(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* adjacency_offset,
                                    unsigned char* scratch, uint8_t* taken);
 /* meshlets_pack.c: packs the plan's underfull meshlets (before the merge: every meshlet is its
  * own group) into groups by their joints, never over a limit, never more meshlets. */
 size_t sp_meshlet_pack_scratch_bound(size_t triangle_count);
 void sp_meshlet_plan_pack(sp_meshlet_context* ctx, sp_meshlet_plan* plan, unsigned char* scratch);
-/* Merges underfull meshlets with near ones they fit with (rank: triangle -> Morton position). */
+/* meshlets_merge.c: merges underfull meshlets with near ones they fit with (rank: triangle ->
+ * Morton position). */
 void sp_meshlet_plan_merge(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* rank);
 /* meshlets_refine.c: turns the merged groups into triangle lists; then moves the few triangles
  * that bring a joint into a meshlet to a neighbour where they cost fewer palette entries, never

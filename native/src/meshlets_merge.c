@@ -92,7 +92,7 @@ static int groups_fit(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint
     return fit;
 }
 
-static int compare_keys(const void* x, const void* y)
+int sp_meshlet_compare_u64(const void* x, const void* y)
 {
     uint64_t a = *(const uint64_t*)x, b = *(const uint64_t*)y;
     return (a > b) - (a < b);
@@ -108,12 +108,12 @@ static size_t list_underfull(const sp_meshlet_context* ctx, sp_meshlet_plan* pla
         if (!plan->merged[m] && (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
                                  plan->triangle_count[m] < ctx->options.max_triangles / 2))
             plan->keys[count++] = (uint64_t)rank[plan->order[plan->start[m]]] << 32 | m;
-    qsort(plan->keys, count, sizeof(uint64_t), compare_keys);
+    qsort(plan->keys, count, sizeof(uint64_t), sp_meshlet_compare_u64);
     for (size_t i = 0; i < count; ++i)
         plan->spatial[i] = (uint32_t)plan->keys[i];
     for (size_t i = 0; i < count; ++i)
         plan->keys[i] = (uint64_t)plan->vertex_count[plan->spatial[i]] << 32 | i;
-    qsort(plan->keys, count, sizeof(uint64_t), compare_keys);
+    qsort(plan->keys, count, sizeof(uint64_t), sp_meshlet_compare_u64);
     return count;
 }
 

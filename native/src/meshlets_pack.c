@@ -62,12 +62,6 @@ size_t sp_meshlet_pack_scratch_bound(size_t triangle_count)
            sp_meshlet_align8(m * sizeof(pack_bin)) + sp_meshlet_align8(JOINT_MARKS * sizeof(uint32_t));
 }
 
-static int compare_u64(const void* x, const void* y)
-{
-    uint64_t a = *(const uint64_t*)x, b = *(const uint64_t*)y;
-    return (a > b) - (a < b);
-}
-
 /* The pieces, largest first (fewest free vertices, then fewest free triangles, then plan order),
  * with their palettes copied into the pool. */
 static void collect_pieces(packer* p, sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint64_t* keys)
@@ -77,7 +71,7 @@ static void collect_pieces(packer* p, sp_meshlet_context* ctx, const sp_meshlet_
         if (!plan->merged[m] && plan->vertex_count[m] + 3u <= ctx->options.max_vertices)
             keys[count++] = (uint64_t)(ctx->options.max_vertices - plan->vertex_count[m]) << 42 |
                             (uint64_t)(ctx->options.max_triangles - plan->triangle_count[m]) << 32 | m;
-    qsort(keys, count, sizeof(uint64_t), compare_u64);
+    qsort(keys, count, sizeof(uint64_t), sp_meshlet_compare_u64);
     for (uint32_t i = 0; i < count; ++i) {
         uint32_t m = (uint32_t)keys[i];
         for (uint32_t k = plan->start[m]; k < plan->start[m + 1]; ++k)
@@ -283,11 +277,11 @@ void sp_meshlet_plan_pack(sp_meshlet_context* ctx, sp_meshlet_plan* plan, unsign
     collect_pieces(&p, ctx, plan, keys);
     if (p.piece_count < 2)
         return;
-    size_t count_first = pack_greedy(&p, 0);
-    uint32_t count_first_bins = p.bin_count;
     size_t joints_first = pack_greedy(&p, 1);
-    if (count_first_bins < p.bin_count || (count_first_bins == p.bin_count && count_first <= joints_first))
-        pack_greedy(&p, 0); /* the count-first run again: it is the one kept */
+    uint32_t joints_first_bins = p.bin_count;
+    size_t count_first = pack_greedy(&p, 0); /* last: kept on ties, then with no rerun */
+    if (joints_first_bins < p.bin_count || (joints_first_bins == p.bin_count && joints_first < count_first))
+        pack_greedy(&p, 1); /* the joints-first run again: it is the one kept */
     if (p.piece_count <= SEARCH_PIECES)
         pack_search(&p);
     apply_bins(&p, plan);

@@ -80,7 +80,7 @@ size_t sp_meshlet_plan_close_parts(sp_meshlet_context* ctx, sp_meshlet_plan* pla
     find_parts(ctx, adjacency_offset, parent, part_start, part_fill, list);
     size_t closed = 0;
     for (size_t r = 0; r < v_count; ++r) {
-        if (part_start[r] == UINT32_MAX || part_fill[r] == 0)
+        if (part_start[r] == UINT32_MAX) /* not a root, or a part too large or too small */
             continue;
         const uint32_t* part = list + part_start[r];
         int fits = 1;
@@ -100,4 +100,3 @@ size_t sp_meshlet_plan_close_parts(sp_meshlet_context* ctx, sp_meshlet_plan* pla
     }
     return closed;
 }
-

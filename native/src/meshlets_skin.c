@@ -120,12 +120,6 @@ static uint32_t spread_bits(uint32_t x)
     return x;
 }
 
-static int compare_u64(const void* a, const void* b)
-{
-    uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
-    return (x > y) - (x < y);
-}
-
 static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
 {
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
@@ -156,7 +150,7 @@ static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
         }
         s->morton[t] = (uint64_t)code << 32 | t;
     }
-    qsort(s->morton, ctx->triangle_count, sizeof(uint64_t), compare_u64);
+    qsort(s->morton, ctx->triangle_count, sizeof(uint64_t), sp_meshlet_compare_u64);
     for (size_t i = 0; i < ctx->triangle_count; ++i)
         s->rank[(uint32_t)s->morton[i]] = (uint32_t)i;
 }
