@@ -7,11 +7,14 @@
  * For each mesh and each limit pair (64 vertices with 124 and 126 triangles): meshoptimizer
  * 1.3's MeshoptClusterizer.buildMeshlets (cone weight 0; run by meshlets_mo13.mjs, which hands
  * back its meshlets), meshopt_buildMeshlets 0.18 (cone weight 0), the thesis's two builders at
- * palette cap 32 and our skin builder at palette caps 16 and 32. Every split gets the same
- * analysis (palette = joints with non-zero weight on the meshlet's vertices, local tuple LUT by
- * the library's rule; the bench re-derives ours from our vertex lists and stops if they
- * disagree with the library), and every split is checked against the joint lower bound
- * (joint_bound.h): the bench stops if any split beats it. meshoptimizer has no palette cap, so
+ * palette cap 32 and our skin builder at palette caps 16 and 32, each with two weight sets: the
+ * prepared weights and the weights as compressed (mesh_data_decode_compressed: what
+ * `skinpack compress --meshlets` builds from). meshoptimizer ignores weights: its splits are
+ * built once and analysed with both. Every split gets the same analysis (palette = joints with
+ * non-zero weight on the meshlet's vertices, local tuple LUT by the library's rule; the bench
+ * re-derives ours from our vertex lists and stops if they disagree with the library), and every
+ * split is checked against the joint lower bound (joint_bound.h) of its weight set: the bench
+ * stops if any split beats it. meshoptimizer has no palette cap, so
  * its meshlets over 16 and over 32 joints are counted. Times are the fastest of N runs (default
  * 5; 5 N on meshes under 20k triangles), process CPU time (node: process.cpuUsage); nothing
  * here is asserted.
@@ -212,19 +215,18 @@ static split bench_meshopt_13(const mesh_data* mesh, const char* node, const cha
     return s;
 }
 
-static row bench_ours(const meshlet_input* in_weights, const char* name, uint32_t builder, uint32_t max_triangles,
+static row bench_ours(const meshlet_input* in, const char* name, uint32_t builder, uint32_t max_triangles,
                       uint32_t palette, int reps)
 {
-    meshlet_input in = *in_weights;
     sp_meshlet_options o = meshlet_options(builder, MAX_VERTICES, max_triangles, palette);
     meshlet_run run;
     row r = {"", 0, 0, 0, 0, 0, 0, 0, 1e30};
     snprintf(r.builder, sizeof(r.builder), "%s, palette cap %u", name, palette);
-    meshlet_run_build(&run, &in, &o); /* allocates; the timed calls reuse the buffers */
+    meshlet_run_build(&run, in, &o); /* allocates; the timed calls reuse the buffers */
     for (int i = 0; i < reps; ++i) {
         double start = cpu_ms();
-        sp_result result = sp_build_meshlets(in.indices, in.index_count, in.positions, in.vertex_count,
-                                             3 * sizeof(float), in.joints, in.weights, in.influences, &o, &run.out,
+        sp_result result = sp_build_meshlets(in->indices, in->index_count, in->positions, in->vertex_count,
+                                             3 * sizeof(float), in->joints, in->weights, in->influences, &o, &run.out,
                                              run.scratch, run.scratch_size, &run.stats);
         double ms = cpu_ms() - start;
         if (result != SP_OK)
@@ -239,7 +241,7 @@ static row bench_ours(const meshlet_input* in_weights, const char* name, uint32_
         spans[m].offset = run.out.meshlets[m].vertex_offset;
         spans[m].count = run.out.meshlets[m].vertex_count;
     }
-    analyse_split(&r, &in, run.out.vertices, spans, s->meshlet_count);
+    analyse_split(&r, in, run.out.vertices, spans, s->meshlet_count);
     if (r.palette_entries != s->joint_count || r.max_joints != s->max_joints ||
         r.local_bits < s->local_tuple_bits_mean - 1e-9 || r.local_bits > s->local_tuple_bits_mean + 1e-9)
         die(name, "the library's statistics disagree with the bench's analysis of its meshlets");
