@@ -206,11 +206,12 @@ static uint32_t inner_ring(const sp_meshlet_context* ctx, const skin_state* s, c
     return ring;
 }
 
-/* Adds t to the open meshlet and takes it out of its vertices' live lists; its new vertices get
- * the ring after its innermost corner's (ring 0 when none is in the meshlet: a seed or a jump). */
+/* Adds t to the open meshlet and takes it out of its vertices' live lists; on a regular mesh its
+ * new vertices get the ring after its innermost corner's (0 when none is in the meshlet: a seed
+ * or a jump). */
 static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
 {
-    uint32_t ring = inner_ring(ctx, s, ctx->indices + (size_t)t * 3);
+    uint32_t ring = s->regular ? inner_ring(ctx, s, ctx->indices + (size_t)t * 3) : 0;
     uint32_t first_new = ctx->open_vertex_count;
     for (int c = 0; c < 3; ++c) {
         uint32_t v = ctx->indices[t * 3 + c];
@@ -220,7 +221,7 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
         }
     }
     sp_meshlet_add(ctx, t);
-    for (uint32_t i = first_new; i < ctx->open_vertex_count; ++i)
+    for (uint32_t i = first_new; s->regular && i < ctx->open_vertex_count; ++i)
         s->ring[i] = (uint16_t)(ring == UINT16_MAX ? 0 : ring + 1);
     for (int i = 0; i < 3; ++i)
         s->centroid_sum[i] += s->centroid[(size_t)t * 3 + i];
@@ -362,7 +363,7 @@ static uint32_t new_tuples(const sp_meshlet_context* ctx, const skin_state* s, u
 typedef struct candidate {
     uint32_t triangle;
     float cost;     /* priority + joint_cost * new joints + tuple_cost * new tuples: lower is better */
-    uint32_t joints, ring; /* on a regular mesh: new joints, innermost ring of its corners; else 0 */
+    uint32_t rank;  /* on a regular mesh new joints << 16 | innermost ring of its corners; else 0 */
     float distance; /* squared, centroid to the meshlet's centroid (meshopt's tie-break), x (1 + factor x new joints) */
 } candidate;
 
@@ -372,10 +373,8 @@ static int better(const candidate* a, const candidate* b)
         return 1;
     if (a->cost != b->cost)
         return a->cost < b->cost;
-    if (a->joints != b->joints)
-        return a->joints < b->joints;
-    if (a->ring != b->ring)
-        return a->ring < b->ring;
+    if (a->rank != b->rank)
+        return a->rank < b->rank;
     if (a->distance != b->distance)
         return a->distance < b->distance;
     return a->triangle < b->triangle;
@@ -401,7 +400,7 @@ static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_
  * worse than the best so far is skipped before they are counted. */
 static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
 {
-    candidate best = {NO_TRIANGLE, 0.0f, 0, 0, 0.0f};
+    candidate best = {NO_TRIANGLE, 0.0f, 0, 0.0f};
     if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
         return best;
     float point[3];
@@ -432,11 +431,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
                 continue;
             /* among equal costs a candidate that widens the palette counts as farther */
             float distance = distance_to(s, t, point) * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
-            candidate c = {t, cost, 0, 0, distance};
-            if (s->regular) {
-                c.joints = new_joints;
-                c.ring = inner_ring(ctx, s, tri);
-            }
+            candidate c = {t, cost, s->regular ? new_joints << 16 | inner_ring(ctx, s, tri) : 0, distance};
             if (cost == 0.0f)
                 return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
                            * such triangles join does not change the meshlet */
