@@ -15,7 +15,10 @@
  * meshlet then closes along the palette it has (0-4 % fewer palette entries on the benchmark
  * meshes, no more meshlets). Ties go to the candidate nearest the centre of the meshlet's
  * triangles, its distance scaled by 1 + JOINT_DISTANCE_FACTOR per joint it would add, which
- * keeps the meshlets compact and still steers growth along the palette. When no adjacent
+ * keeps the meshlets compact and still steers growth along the palette; on a regular
+ * triangulation (is_regular: a subdivision surface) first to the fewest new joints, then to the
+ * innermost hop ring from the meshlet's first vertices, which keeps them compact in the
+ * topology that the vertex limit counts, whatever the triangles' shape. When no adjacent
  * triangle fits, the meshlet closes, leaves seed candidates on its border, and the next meshlet
  * starts at the least enclosed seed (fewest free triangles around its corners, then nearest the
  * mesh's low corner), so meshlets sweep across the surface and leave no slivers behind. When
@@ -41,6 +44,8 @@
 #define LATE_JOINT_COST 3.0f      /* where a new palette joint costs as much as 3 new vertices */
 #define SEEDS_PER_MESHLET 4       /* seed candidates a finished meshlet leaves on its border */
 #define SEED_POOL 256             /* seed candidates kept at most */
+#define REGULAR_VALENCE 6         /* triangles around an interior vertex of a regular triangulation */
+#define REGULAR_SHARE 0.9         /* the share of such vertices from which a mesh counts as regular */
 
 typedef struct skin_state {
     uint32_t* adjacency_offset; /* vertex_count + 1: start of each vertex's triangle list */
@@ -61,6 +66,8 @@ typedef struct skin_state {
     uint32_t seed_count;
     sp_meshlet_plan plan;       /* the meshlets closed so far, written at the end */
     float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
+    int regular;                /* growth ranks ties by rings (is_regular) */
+    uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
 
 size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
@@ -107,6 +114,25 @@ static void build_adjacency(const sp_meshlet_context* ctx, skin_state* s)
                 uint32_t v = ctx->indices[t * 3 + c];
                 s->adjacency[s->adjacency_offset[v] + s->live[v]++] = (uint32_t)t;
             }
+}
+
+/* Whether at least REGULAR_SHARE of the used vertices are in REGULAR_VALENCE triangles, as on a
+ * subdivision surface. There, growth ranks candidates of equal cost by the fewest joints they
+ * add, then by the innermost ring (edge hops from the meshlet's first vertices) of their corners,
+ * then by distance: the vertex limit counts vertices, and hop rings make the meshlet a compact
+ * disc of the triangulation, while distance to the centre stretches it along the short edges of
+ * anisotropic triangles (cylinder_sub: 88 triangles per meshlet against 96 by rings and 98 in an
+ * 8 x 8 grid). On irregular meshes, where triangle sizes vary, hop rings follow the joints worse
+ * than distance (docs/benchmarks-meshlets.md), so they keep the distance tie-break alone. Needs
+ * live[] as build_adjacency leaves it (triangles per vertex). */
+static int is_regular(const sp_meshlet_context* ctx, const skin_state* s)
+{
+    size_t used = 0, regular = 0;
+    for (size_t v = 0; v < ctx->vertex_count; ++v) {
+        used += s->live[v] > 0;
+        regular += s->live[v] == REGULAR_VALENCE;
+    }
+    return used > 0 && (double)regular >= REGULAR_SHARE * (double)used;
 }
 
 /* 10 bits per axis interleaved: z y x z y x ... */
@@ -168,9 +194,25 @@ static float distance_to(const skin_state* s, uint32_t t, const float* point)
     return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
 }
 
-/* Adds t to the open meshlet and takes it out of its vertices' live lists. */
+/* The innermost ring of tri's corners in the open meshlet; UINT16_MAX if none is in it. */
+static uint32_t inner_ring(const sp_meshlet_context* ctx, const skin_state* s, const uint32_t* tri)
+{
+    uint32_t ring = UINT16_MAX;
+    for (int c = 0; c < 3; ++c) {
+        uint8_t slot = ctx->vertex_slot[tri[c]];
+        if (slot != SP_MESHLET_NO_SLOT && s->ring[slot] < ring)
+            ring = s->ring[slot];
+    }
+    return ring;
+}
+
+/* Adds t to the open meshlet and takes it out of its vertices' live lists; on a regular mesh its
+ * new vertices get the ring after its innermost corner's (0 when none is in the meshlet: a seed
+ * or a jump). */
 static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
 {
+    uint32_t ring = s->regular ? inner_ring(ctx, s, ctx->indices + (size_t)t * 3) : 0;
+    uint32_t first_new = ctx->open_vertex_count;
     for (int c = 0; c < 3; ++c) {
         uint32_t v = ctx->indices[t * 3 + c];
         if (ctx->vertex_slot[v] == SP_MESHLET_NO_SLOT && s->tuple_stamp[s->vertex_tuple[v]] != s->open_stamp) {
@@ -179,6 +221,8 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
         }
     }
     sp_meshlet_add(ctx, t);
+    for (uint32_t i = first_new; s->regular && i < ctx->open_vertex_count; ++i)
+        s->ring[i] = (uint16_t)(ring == UINT16_MAX ? 0 : ring + 1);
     for (int i = 0; i < 3; ++i)
         s->centroid_sum[i] += s->centroid[(size_t)t * 3 + i];
     s->emitted[t] = 1;
@@ -319,6 +363,7 @@ static uint32_t new_tuples(const sp_meshlet_context* ctx, const skin_state* s, u
 typedef struct candidate {
     uint32_t triangle;
     float cost;     /* priority + joint_cost * new joints + tuple_cost * new tuples: lower is better */
+    uint32_t rank;  /* on a regular mesh new joints << 16 | innermost ring of its corners; else 0 */
     float distance; /* squared, centroid to the meshlet's centroid (meshopt's tie-break), x (1 + factor x new joints) */
 } candidate;
 
@@ -328,6 +373,8 @@ static int better(const candidate* a, const candidate* b)
         return 1;
     if (a->cost != b->cost)
         return a->cost < b->cost;
+    if (a->rank != b->rank)
+        return a->rank < b->rank;
     if (a->distance != b->distance)
         return a->distance < b->distance;
     return a->triangle < b->triangle;
@@ -353,7 +400,7 @@ static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_
  * worse than the best so far is skipped before they are counted. */
 static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
 {
-    candidate best = {NO_TRIANGLE, 0.0f, 0.0f};
+    candidate best = {NO_TRIANGLE, 0.0f, 0, 0.0f};
     if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
         return best;
     float point[3];
@@ -384,7 +431,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
                 continue;
             /* among equal costs a candidate that widens the palette counts as farther */
             float distance = distance_to(s, t, point) * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
-            candidate c = {t, cost, distance};
+            candidate c = {t, cost, s->regular ? new_joints << 16 | inner_ring(ctx, s, tri) : 0, distance};
             if (cost == 0.0f)
                 return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
                            * such triangles join does not change the meshlet */
@@ -458,6 +505,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
+    s.regular = is_regular(ctx, &s);
     build_spatial_order(ctx, &s);
     size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
 

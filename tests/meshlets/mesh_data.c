@@ -81,8 +81,60 @@ int mesh_data_load(const char* path, size_t influences, mesh_data* m)
     return 1;
 }
 
+static size_t used_slots(const float* weights, size_t k)
+{
+    size_t used = 0;
+    for (size_t s = 0; s < k; ++s)
+        used += weights[s] > 0.0f;
+    return used;
+}
+
+int mesh_data_decode_compressed(mesh_data* m)
+{
+    size_t v = m->vertex_count, k = m->input_influences;
+    size_t scratch_size = sp_compress_scratch_bound(v, k);
+    uint32_t* words = malloc(v * 2 * sizeof(uint32_t) + 1);
+    uint16_t* lut = malloc(v * SP_MAX_INFLUENCES * sizeof(uint16_t) + 1);
+    void* scratch = malloc(scratch_size + 1);
+    m->decoded_joints = malloc(v * SP_MAX_INFLUENCES * sizeof(uint16_t) + 1);
+    m->decoded_weights = malloc(v * SP_MAX_INFLUENCES * sizeof(float) + 1);
+    int ok = 0;
+    sp_compress_options options;
+    sp_compress_options_default(&options);
+    sp_compressed_skin skin;
+    if (!words || !lut || !scratch || !m->decoded_joints || !m->decoded_weights) {
+        fprintf(stderr, "mesh_data: compress and decode: out of memory\n");
+        goto done;
+    }
+    sp_result r = sp_compress_skin(m->input_joints, m->input_weights, v, k, m->joint_count, &options, words, lut, NULL, NULL,
+                             &skin, scratch, scratch_size);
+    if (r == SP_OK)
+        r = sp_decompress_skin(&skin.codec, words, v, skin.tuple_bits, lut, skin.lut_size, skin.joint_count,
+                               m->decoded_joints, m->decoded_weights, NULL);
+    if (r == SP_OK) {
+        m->decoded_influences = skin.influences;
+        m->decoded_weight_bits = skin.weight_bits;
+        m->decoded_tuple_bits = skin.tuple_bits;
+        m->decoded_max_error = skin.codec.max_error;
+        m->decoded_lut_size = skin.lut_size;
+        m->lost_influences = 0;
+        for (size_t i = 0; i < v; ++i) /* a zero weight encodes as zero: decoding never adds a slot */
+            m->lost_influences += used_slots(m->weights + i * m->influences, m->influences) -
+                                  used_slots(m->decoded_weights + i * skin.influences, skin.influences);
+        ok = 1;
+    } else
+        fprintf(stderr, "mesh_data: compress and decode: %s\n", sp_result_string(r));
+done:
+    free(words);
+    free(lut);
+    free(scratch);
+    return ok;
+}
+
 void mesh_data_free(mesh_data* m)
 {
+    free(m->decoded_joints);
+    free(m->decoded_weights);
     free(m->positions);
     free(m->indices);
     free(m->input_joints);
