@@ -266,10 +266,11 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants
         ordered[b] = weights_ordered(w[b], k);
     }
     if (ENCODE_FUSED)
-        for (size_t b = 0; b < blocks; ++b) {
-            deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
-            store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+        for (size_t b = 0; b < blocks; ++b) { /* the block's floors in locals: registers, not the chunk's arrays */
+            vec floors[SP_MAX_INFLUENCES], rest[SP_MAX_INFLUENCES];
+            vec short_by = quantize_floor(w[b], k, s, scale[b], floors, rest);
+            any |= missed[b] = round_block(k, short_by, rest, floors, ordered[b]);
+            store_block(floors, k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
         }
     else {
         for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);

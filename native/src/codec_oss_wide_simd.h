@@ -142,15 +142,34 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
+/* K = 4: the layer base u(k) = floor(a / 9), a = c k + 2 with c = (4k - 6N - 9) k + 3N^2 + 9N + 6
+ * (layer_base's Horner form), for encode, split as u(k) = floor(c / 9) k + floor((r k + 2) / 9)
+ * with r = c mod 9: c (below 2^46 at 64-bit codes, and positive for k <= (N + 1) / 2) and its
+ * quotient are exact doubles, the quotient's floor exact as in layer_base (c/9 + 1/18 lies at
+ * least 1/18 from an integer), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
+ * 2^64 as the sum is below 2^64) needs the integer lanes: one product where wide_layer_base
+ * takes three and a table. Returns floor(c / 9) k; *small = floor((r k + 2) / 9). */
+SP_INLINE SIMD_FN uvec wide_layer_split(const wide_codec* c, vec k, vec* small)
+{
+    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
+    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
+    vec rest = v_fnmadd(ninth, v_splat(9.0), inner);
+    *small = v_floor(v_mul(v_fmadd(rest, k, v_splat(2.5)), v_splat(1.0 / 9.0)));
+    return u_mul_u32(u_from_v(ninth), u_from_v(k));
+}
+
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
- * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h. */
+ * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h,
+ * which also adds the layer base's small part (wide_layer_split). */
 SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
     if (k == 2) return u_from_v(q[1]);
     if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
-    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n));
-    vec in_layer = v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2]));
-    return u_add(wide_layer_base(c, u_from_v(q[3])), u_from_v(in_layer));
+    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n)), small;
+    uvec layer = wide_layer_split(c, q[3], &small);
+    vec in_layer = v_add(v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2])), small);
+    return u_add(layer, u_from_v(in_layer));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
@@ -169,7 +188,9 @@ SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, 
 
 /* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
  * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
- * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes; constants: the
+ * stage spill, as in codec_oss_simd.h; and for K = 4, whose index with its 64-bit product makes
+ * one stage's chain too long for the core to overlap blocks: two stages ran AVX-512 K = 4 ~11%
+ * faster on Zen 4, K = 3 2% slower), then the scalar redo of the missed lanes; constants: the
  * wide_codec. */
 SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* constants, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
@@ -183,7 +204,7 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
         scale[b] = quantize_scale(w[b], k, c->scale);
         ordered[b] = weights_ordered(w[b], k);
     }
-    if (ENCODE_FUSED)
+    if (ENCODE_FUSED && k < 4)
         for (size_t b = 0; b < blocks; ++b)
             missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     else {
