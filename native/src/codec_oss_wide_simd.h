@@ -198,7 +198,7 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
 {
     const wide_codec* c = (const wide_codec*)constants;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
-    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, c->scale);
@@ -206,20 +206,21 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     }
     if (ENCODE_FUSED && k < 4)
         for (size_t b = 0; b < blocks; ++b)
-            missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+            any |= missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK,
+                                                 significant ? significant + b * BLOCK : NULL);
     else {
         vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
         vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
         for (size_t b = 0; b < blocks; ++b) {
             deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
+            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
         }
         for (size_t b = 0; b < blocks; ++b) {
             u_store(codes + b * BLOCK, wide_pack(c, q[b], k));
             if (significant) store_significant(q[b], k, significant + b * BLOCK);
         }
     }
-    redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
+    if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }
 
 DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)
