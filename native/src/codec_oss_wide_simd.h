@@ -178,9 +178,8 @@ SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, unsigned ordered, uint32_t k,
                                              uint64_t* codes, uint8_t* significant)
 {
-    vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
-    vec deficit = quantize_floor(w, k, c->scale, scale, q, remainder);
-    unsigned missed = round_block(k, deficit, remainder, q, ordered);
+    vec q[SP_MAX_INFLUENCES];
+    unsigned missed = quantize_block(w, k, c->scale, scale, ordered, q);
     u_store(codes, wide_pack(c, q, k));
     if (significant) store_significant(q, k, significant);
     return missed;
@@ -209,15 +208,11 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
             any |= missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK,
                                                  significant ? significant + b * BLOCK : NULL);
     else {
-        vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
-        vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
+        for (size_t b = 0; b < blocks; ++b) /* the floors replace the weights */
+            any |= missed[b] = quantize_block(w[b], k, c->scale, scale[b], ordered[b], w[b]);
         for (size_t b = 0; b < blocks; ++b) {
-            deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
-            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
-        }
-        for (size_t b = 0; b < blocks; ++b) {
-            u_store(codes + b * BLOCK, wide_pack(c, q[b], k));
-            if (significant) store_significant(q[b], k, significant + b * BLOCK);
+            u_store(codes + b * BLOCK, wide_pack(c, w[b], k));
+            if (significant) store_significant(w[b], k, significant + b * BLOCK);
         }
     }
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
