@@ -16,7 +16,8 @@
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN):
  *   vec, mask          BLOCK double lanes and a lane mask; BLOCK, ENCODE_CHUNK, DECODE_CHUNK,
- *                      ENCODE_FUSED (1: encode's floors, rounding and indices in one stage)
+ *                      ENCODE_FUSED (1: encode's floors, rounding and indices in one stage for
+ *                      K < 4, encode_fused)
  *   simd_layout        whatever load/store need per K (permute indices), from layout_for(k)
  *   v_splat v_zero v_add v_sub v_mul v_div v_sqrt v_max v_min v_floor v_trunc
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
@@ -257,14 +258,23 @@ SP_INLINE SIMD_FN void store_block(const vec* q, uint32_t k, double n, uint64_t*
     if (significant) store_significant(q, k, significant);
 }
 
-/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the quantisation's division, then its
- * floors, rounding and indices in one stage where ENCODE_FUSED (with 32 registers a block's
- * floors stay in registers through the rounding and the index, ~15% faster for K = 3, 4 on
- * AVX-512), else in two: floors and rounding (the floors replacing the weights), then the indices
- * (with 16 registers one stage spills, ~25% slower for K = 4 on AVX2; on Zen 4 these two ran
- * AVX2 K = 2 ~1.2x, K = 3 ~1.1x, K = 4 ~1.07x as fast as three, the rounding a stage of its own);
- * then the scalar redo of the lanes the vector code cannot prove exact. The fused floors stay
- * locals, as the remainders do (quantize_block): no stores of them. */
+/* Whether a chunk's floors, rounding and indices run in one stage (else two: floors and
+ * rounding, then the indices). One where ENCODE_FUSED (with 32 registers a block's floors stay
+ * in registers through the rounding and the index: on Zen 4 AVX-512 K = 2 ~1.14x as fast as in
+ * two stages, K = 3 the same) but for K = 4, whose index chain (and the wide lanes' 64-bit
+ * product) makes one stage too long for the core to overlap blocks: two stages ran AVX-512
+ * K = 4 ~1.07x as fast, the wide lanes ~1.1x. With 16 registers (AVX2) one stage spills (~25%
+ * slower for K = 4), and two stages ran K = 2 ~1.2x, K = 3 ~1.1x, K = 4 ~1.07x as fast as
+ * three with the rounding a stage of its own. */
+SP_INLINE int encode_fused(uint32_t k)
+{
+    return ENCODE_FUSED && k < 4;
+}
+
+/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the quantisation's division, then the
+ * floors, rounding and indices (encode_fused), then the scalar redo of the lanes the vector code
+ * cannot prove exact. The fused floors stay locals, as the remainders do (quantize_block): no
+ * stores of them; unfused, the floors replace the weights. */
 SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants, const float* weights, size_t blocks,
                                     uint64_t* codes, uint8_t* significant, uint32_t k, const simd_layout* layout)
 {
@@ -278,11 +288,11 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants
         ordered[b] = weights_ordered(w[b], k);
     }
     for (size_t b = 0; b < blocks; ++b) {
-        vec floors[SP_MAX_INFLUENCES], *q = ENCODE_FUSED ? floors : w[b];
+        vec floors[SP_MAX_INFLUENCES], *q = encode_fused(k) ? floors : w[b];
         any |= missed[b] = quantize_block(w[b], k, s, scale[b], ordered[b], q);
-        if (ENCODE_FUSED) store_block(q, k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+        if (encode_fused(k)) store_block(q, k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
-    if (!ENCODE_FUSED)
+    if (!encode_fused(k))
         for (size_t b = 0; b < blocks; ++b)
             store_block(w[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */

@@ -186,11 +186,8 @@ SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, 
 }
 
 /* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
- * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
- * stage spill, as in codec_oss_simd.h; and for K = 4, whose index with its 64-bit product makes
- * one stage's chain too long for the core to overlap blocks: two stages ran AVX-512 K = 4 ~11%
- * faster on Zen 4, K = 3 2% slower), then the scalar redo of the missed lanes; constants: the
- * wide_codec. */
+ * each block (in one stage or two, as codec_oss_simd.h's encode_fused says), then the scalar
+ * redo of the missed lanes; constants: the wide_codec. */
 SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* constants, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
                                          const simd_layout* layout)
@@ -203,7 +200,7 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
         scale[b] = quantize_scale(w[b], k, c->scale);
         ordered[b] = weights_ordered(w[b], k);
     }
-    if (ENCODE_FUSED && k < 4)
+    if (encode_fused(k))
         for (size_t b = 0; b < blocks; ++b)
             any |= missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK,
                                                  significant ? significant + b * BLOCK : NULL);
