@@ -20,7 +20,7 @@ _Static_assert(SIMD_ISA == SP_ISA_AVX512, "SIMD_ISA is this file's sp_isa");
 #define BLOCK 8
 #define ENCODE_CHUNK 16 /* blocks per stage: on Zen 5, 8 is ~3% slower for K = 3, 4, 32 no faster */
 #define DECODE_CHUNK 16 /* on Zen 5, 8 is ~5% slower for K = 3, 4 decode (4 was ~20% slower on Zen 4) */
-#define ENCODE_FUSED 1  /* K = 3, 4 encode ~15% faster on Zen 5 than in three stages */
+#define ENCODE_FUSED 1  /* K = 2, 3 encode in one stage (encode_fused); K = 3 ~15% faster on Zen 5 than in three */
 
 typedef __m512d vec;
 typedef __mmask8 mask;

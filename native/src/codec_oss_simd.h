@@ -16,7 +16,8 @@
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN):
  *   vec, mask          BLOCK double lanes and a lane mask; BLOCK, ENCODE_CHUNK, DECODE_CHUNK,
- *                      ENCODE_FUSED (1: encode's floors, rounding and indices in one stage)
+ *                      ENCODE_FUSED (1: encode's floors, rounding and indices in one stage for
+ *                      K < 4, encode_fused)
  *   simd_layout        whatever load/store need per K (permute indices), from layout_for(k)
  *   v_splat v_zero v_add v_sub v_mul v_div v_sqrt v_max v_min v_floor v_trunc
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
@@ -240,6 +241,16 @@ SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remai
     return ~(m_bits(quantize_round(k, deficit, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
 }
 
+/* sp_grid_quantize of one block into q (which may be w: each floor replaces its weight after
+ * the weight's last read): the lanes it cannot prove exact, as bits (round_block). The
+ * remainders, which only the rounding reads, stay locals: registers, no stores. */
+SP_INLINE SIMD_FN unsigned quantize_block(const vec* w, uint32_t k, double s, vec scale, unsigned ordered, vec* q)
+{
+    vec remainder[SP_MAX_INFLUENCES];
+    vec deficit = quantize_floor(w, k, s, scale, q, remainder);
+    return round_block(k, deficit, remainder, q, ordered);
+}
+
 /* The indices (and counts) of one block's sorted lanes. */
 SP_INLINE SIMD_FN void store_block(const vec* q, uint32_t k, double n, uint64_t* codes, uint8_t* significant)
 {
@@ -247,36 +258,43 @@ SP_INLINE SIMD_FN void store_block(const vec* q, uint32_t k, double n, uint64_t*
     if (significant) store_significant(q, k, significant);
 }
 
-/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the quantisation's division, its floors,
- * its rounding, the indices (the last three one stage where ENCODE_FUSED: with 32 registers a
- * block's floors stay in registers through the rounding and the index, ~15% faster for K = 3, 4
- * on AVX-512; with 16 they spill, ~25% slower for K = 4 on AVX2), and the scalar redo of the
- * lanes the vector code cannot prove exact. */
+/* Whether a chunk's floors, rounding and indices run in one stage (else two: floors and
+ * rounding, then the indices). One where ENCODE_FUSED (with 32 registers a block's floors stay
+ * in registers through the rounding and the index: on Zen 4 AVX-512 K = 2 ~1.14x as fast as in
+ * two stages, K = 3 the same) but for K = 4, whose index chain (and the wide lanes' 64-bit
+ * product) makes one stage too long for the core to overlap blocks: two stages ran AVX-512
+ * K = 4 ~1.07x as fast, the wide lanes ~1.1x. With 16 registers (AVX2) one stage spills (~25%
+ * slower for K = 4), and two stages ran K = 2 ~1.2x, K = 3 ~1.1x, K = 4 ~1.07x as fast as
+ * three with the rounding a stage of its own. */
+SP_INLINE int encode_fused(uint32_t k)
+{
+    return ENCODE_FUSED && k < 4;
+}
+
+/* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the quantisation's division, then the
+ * floors, rounding and indices (encode_fused), then the scalar redo of the lanes the vector code
+ * cannot prove exact. The fused floors stay locals, as the remainders do (quantize_block): no
+ * stores of them; unfused, the floors replace the weights. */
 SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants, const float* weights, size_t blocks,
                                     uint64_t* codes, uint8_t* significant, uint32_t k, const simd_layout* layout)
 {
     (void)constants;
     double s = (double)codec->scale, n = (double)codec->n;
-    vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK], deficit[ENCODE_CHUNK];
-    vec q[ENCODE_CHUNK][SP_MAX_INFLUENCES], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
+    vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, s);
         ordered[b] = weights_ordered(w[b], k);
     }
-    if (ENCODE_FUSED)
-        for (size_t b = 0; b < blocks; ++b) {
-            deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-            any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
-            store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
-        }
-    else {
-        for (size_t b = 0; b < blocks; ++b) deficit[b] = quantize_floor(w[b], k, s, scale[b], q[b], remainder[b]);
-        for (size_t b = 0; b < blocks; ++b) any |= missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
-        for (size_t b = 0; b < blocks; ++b)
-            store_block(q[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+    for (size_t b = 0; b < blocks; ++b) {
+        vec floors[SP_MAX_INFLUENCES], *q = encode_fused(k) ? floors : w[b];
+        any |= missed[b] = quantize_block(w[b], k, s, scale[b], ordered[b], q);
+        if (encode_fused(k)) store_block(q, k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
+    if (!encode_fused(k))
+        for (size_t b = 0; b < blocks; ++b)
+            store_block(w[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }
 

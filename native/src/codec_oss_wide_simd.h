@@ -142,15 +142,34 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
+/* K = 4: the layer base u(k) = floor(a / 9), a = c k + 2 with c = (4k - 6N - 9) k + 3N^2 + 9N + 6
+ * (layer_base's Horner form), for encode, split as u(k) = floor(c / 9) k + floor((r k + 2) / 9)
+ * with r = c mod 9: c (below 2^46 at 64-bit codes, and positive for k <= (N + 1) / 2) and its
+ * quotient are exact doubles, the quotient's floor exact as in layer_base (c/9 + 1/18 lies at
+ * least 1/18 from an integer), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
+ * 2^64 as the sum is below 2^64) needs the integer lanes: one product where wide_layer_base
+ * takes three and a table. Returns floor(c / 9) k; *small = floor((r k + 2) / 9). */
+SP_INLINE SIMD_FN uvec wide_layer_split(const wide_codec* c, vec k, vec* small)
+{
+    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
+    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
+    vec rest = v_fnmadd(ninth, v_splat(9.0), inner);
+    *small = v_floor(v_mul(v_fmadd(rest, k, v_splat(2.5)), v_splat(1.0 / 9.0)));
+    return u_mul_u32(u_from_v(ninth), u_from_v(k));
+}
+
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
- * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h. */
+ * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h,
+ * which also adds the layer base's small part (wide_layer_split). */
 SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
     if (k == 2) return u_from_v(q[1]);
     if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
-    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n));
-    vec in_layer = v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2]));
-    return u_add(wide_layer_base(c, u_from_v(q[3])), u_from_v(in_layer));
+    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n)), small;
+    uvec layer = wide_layer_split(c, q[3], &small);
+    vec in_layer = v_add(v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2])), small);
+    return u_add(layer, u_from_v(in_layer));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
@@ -159,46 +178,41 @@ SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 SP_INLINE SIMD_FN unsigned wide_encode_block(const wide_codec* c, const vec* w, vec scale, unsigned ordered, uint32_t k,
                                              uint64_t* codes, uint8_t* significant)
 {
-    vec q[SP_MAX_INFLUENCES], remainder[SP_MAX_INFLUENCES];
-    vec deficit = quantize_floor(w, k, c->scale, scale, q, remainder);
-    unsigned missed = round_block(k, deficit, remainder, q, ordered);
+    vec q[SP_MAX_INFLUENCES];
+    unsigned missed = quantize_block(w, k, c->scale, scale, ordered, q);
     u_store(codes, wide_pack(c, q, k));
     if (significant) store_significant(q, k, significant);
     return missed;
 }
 
 /* Encodes `blocks` (<= ENCODE_CHUNK) blocks in stages: the rounding's division, then the rest of
- * each block (in two stages where ENCODE_FUSED is 0: with 16 registers, floors and index in one
- * stage spill, as in codec_oss_simd.h), then the scalar redo of the missed lanes; constants: the
- * wide_codec. */
+ * each block (in one stage or two, as codec_oss_simd.h's encode_fused says), then the scalar
+ * redo of the missed lanes; constants: the wide_codec. */
 SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* constants, const float* weights,
                                          size_t blocks, uint64_t* codes, uint8_t* significant, uint32_t k,
                                          const simd_layout* layout)
 {
     const wide_codec* c = (const wide_codec*)constants;
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
-    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK]; /* lanes as bits */
+    unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
         load_weights(weights + b * BLOCK * k, k, layout, w[b]);
         scale[b] = quantize_scale(w[b], k, c->scale);
         ordered[b] = weights_ordered(w[b], k);
     }
-    if (ENCODE_FUSED)
+    if (encode_fused(k))
         for (size_t b = 0; b < blocks; ++b)
-            missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+            any |= missed[b] = wide_encode_block(c, w[b], scale[b], ordered[b], k, codes + b * BLOCK,
+                                                 significant ? significant + b * BLOCK : NULL);
     else {
-        vec deficit[ENCODE_CHUNK], remainder[ENCODE_CHUNK][SP_MAX_INFLUENCES];
-        vec(*q)[SP_MAX_INFLUENCES] = w; /* the floors replace the weights */
+        for (size_t b = 0; b < blocks; ++b) /* the floors replace the weights */
+            any |= missed[b] = quantize_block(w[b], k, c->scale, scale[b], ordered[b], w[b]);
         for (size_t b = 0; b < blocks; ++b) {
-            deficit[b] = quantize_floor(w[b], k, c->scale, scale[b], q[b], remainder[b]);
-            missed[b] = round_block(k, deficit[b], remainder[b], q[b], ordered[b]);
-        }
-        for (size_t b = 0; b < blocks; ++b) {
-            u_store(codes + b * BLOCK, wide_pack(c, q[b], k));
-            if (significant) store_significant(q[b], k, significant + b * BLOCK);
+            u_store(codes + b * BLOCK, wide_pack(c, w[b], k));
+            if (significant) store_significant(w[b], k, significant + b * BLOCK);
         }
     }
-    redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
+    if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }
 
 DEFINE_ENCODE_WALK(wide_encode_walk, wide_encode_chunk)

@@ -5,7 +5,8 @@
  * row starts (every row of sampled layers; for K = 3 every row just past the double lanes, and
  * the first, last and sampled rows of wider codes, where the root arguments stop being exact),
  * the last codes, random codes and weights from 46 to 64 bits, odd weights, counts and
- * alignments, invalid codes, which stop the batch where the scalar code stops, and for K = 2
+ * alignments, invalid codes, which stop the batch where the scalar code stops, the grid points of
+ * the boundary codes encoded (K = 4: the layer base of every layer), and for K = 2
  * past N = 2^49 (the exact pair rounding) adversarial pairs at 51..63 bits.
  */
 #include <math.h>
@@ -70,7 +71,10 @@ static void boundaries(const sp_codec* c)
     }
     for (uint64_t d = 0; d < 64; ++d) codes[count++] = c->max_code - d;
     compare_decode(c, codes, count, "boundary decode");
-    free(codes);
+    float* w = malloc(count * c->influences * sizeof(float)); /* their grid points: for K = 4 every layer's, */
+    CHECK(sp_decode_weights_batch_isa(c, codes, count, w, NULL, SP_ISA_SCALAR) == SP_OK); /* each k mod 3 and */
+    compare_encode(c, w, count, "boundary encode"); /* layer numerator mod 9 of wide_layer_split */
+    free(codes), free(w);
 }
 
 /* K = 3 just past the double lanes (N = 2^24 + 1): codes around every row start, in batches. */
