@@ -531,8 +531,9 @@ SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex,
     nint three_j = i_add(row, i_add(row, row));
     nint i = i_sub(w, n_row_base(apex, three_j, row));
     nint last = i_sub(i_sub(apex, i_splat(3)), three_j); /* 2B - 2 - 3j */
+    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i_add(i, i), last)));
     n_components(n, k, layer, row, i, q);
-    return n_bits(n_or(i_gt(i_splat(0), i), i_gt(i_add(i, i), last)));
+    return missed;
 }
 
 /* decode_chunk in NBLOCK-lane blocks of 32-bit lanes (up to NARROW_CHUNK), stages as there;
@@ -638,8 +639,9 @@ SP_INLINE SIMD_FN unsigned split_unpack(double n, nint layer, nint bottom, nint 
     i = i_sub_where(i, above, i_add(last, one));
     j = i_add_where(j, above, one);
     last = i_sub(i_sub(i_sub(bottom, j), one), i_shr1(i_add(j, one)));
+    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i, last)));
     n_components(n, 4, layer, j, i, q);
-    return n_bits(n_or(i_gt(i_splat(0), i), i_gt(i, last)));
+    return missed;
 }
 
 /* K = 4 decode of `blocks` NBLOCK-lane blocks (up to SPLIT_CHUNK, 2 BLOCK double blocks each)
