@@ -654,23 +654,22 @@ SP_INLINE SIMD_FN int decode_chunk_split(const sp_codec* codec, const void* cons
 {
     (void)constants;
     double n = (double)codec->n, scale = (double)codec->scale;
-    vec code[2 * SPLIT_CHUNK], layer[2 * SPLIT_CHUNK];
     nint rest[SPLIT_CHUNK], layers[SPLIT_CHUNK], bottom[SPLIT_CHUNK], row[SPLIT_CHUNK];
     nvec mirrored[SPLIT_CHUNK], x[SPLIT_CHUNK], z[SPLIT_CHUNK];
     unsigned missed[SPLIT_CHUNK], any = 0; /* lanes as bits */
-    if (!load_chunk(codec, codes, 2 * blocks, code)) return 0; /* nothing written yet */
-    for (size_t b = 0; b < blocks; ++b) {
-        x[b] = f_from_pair(layer_argument(n, code[2 * b]), layer_argument(n, code[2 * b + 1]));
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) { /* loaded again for the rests: a smaller frame ran ~5% faster */
+        vec first = load_codes(codes + b * NBLOCK, &check), second = load_codes(codes + b * NBLOCK + BLOCK, &check);
+        x[b] = f_from_pair(layer_argument(n, first), layer_argument(n, second));
         z[b] = n_root_start(x[b]);
     }
+    if (!check_passed(&check)) return 0; /* nothing written yet */
+    for (size_t b = 0; b < blocks; ++b) layers[b] = n_layer_finish(n, x[b], z[b], 0.0);
     for (size_t b = 0; b < blocks; ++b) {
-        layers[b] = n_layer_finish(n, x[b], z[b], 0.0);
-        v_from_i_pair(layers[b], &layer[2 * b], &layer[2 * b + 1]);
-    }
-    for (size_t b = 0; b < blocks; ++b) {
-        vec first, second;
-        rest[b] = i_from_pair(split_rest(n, code[2 * b], layer[2 * b], &first),
-                              split_rest(n, code[2 * b + 1], layer[2 * b + 1], &second));
+        vec low, high, first, second;
+        v_from_i_pair(layers[b], &low, &high);
+        rest[b] = i_from_pair(split_rest(n, v_from_u(u_load(codes + b * NBLOCK)), low, &first),
+                              split_rest(n, v_from_u(u_load(codes + b * NBLOCK + BLOCK)), high, &second));
         mirrored[b] = f_from_pair(first, second);
     }
     for (size_t b = 0; b < blocks; ++b) { /* a stage of its own: the root's chain is long */
