@@ -94,6 +94,18 @@ SP_INLINE SIMD_FN nvec i_to_f(nint a) { return _mm256_cvtepi32_ps(a); }
 SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm256_cvttps_epi32(a); } /* NaN and overflow: INT32_MIN */
 SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm256_castps_si256(a); }
 SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm256_castsi256_ps(a); }
+SP_INLINE SIMD_FN nint i_shr1(nint a) { return _mm256_srai_epi32(a, 1); }
+SP_INLINE SIMD_FN nint i_add_where(nint a, nmask m, nint b) { return _mm256_add_epi32(a, _mm256_and_si256(m, b)); }
+SP_INLINE SIMD_FN nint i_sub_where(nint a, nmask m, nint b) { return _mm256_sub_epi32(a, _mm256_and_si256(m, b)); }
+/* Two blocks of double lanes as NBLOCK int32 (integral, in range) or floats (rounded). */
+SP_INLINE SIMD_FN nint i_from_pair(vec a, vec b) { return _mm256_set_m128i(_mm256_cvttpd_epi32(b), _mm256_cvttpd_epi32(a)); }
+SP_INLINE SIMD_FN nvec f_from_pair(vec a, vec b) { return _mm256_set_m128(_mm256_cvtpd_ps(b), _mm256_cvtpd_ps(a)); }
+/* The inverse for int32: NBLOCK int32 lanes as two blocks of doubles (exact). */
+SP_INLINE SIMD_FN void v_from_i_pair(nint a, vec* first, vec* second)
+{
+    *first = _mm256_cvtepi32_pd(_mm256_castsi256_si128(a));
+    *second = _mm256_cvtepi32_pd(_mm256_extracti128_si256(a, 1));
+}
 
 /* floor(a / 9) = floor(a m / 2^33) with m = (2^33 + 1) / 9 for 0 <= a < 2^33 (the error
  * a / (9 2^33) stays below 1/9), on the even and the odd lanes' 64-bit products. */

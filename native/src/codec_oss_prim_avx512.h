@@ -86,6 +86,24 @@ SP_INLINE SIMD_FN nvec i_to_f(nint a) { return _mm512_cvtepi32_ps(a); }
 SP_INLINE SIMD_FN nint i_trunc(nvec a) { return _mm512_cvttps_epi32(a); } /* NaN and overflow: INT32_MIN */
 SP_INLINE SIMD_FN nint f_as_i(nvec a) { return _mm512_castps_si512(a); }
 SP_INLINE SIMD_FN nvec i_as_f(nint a) { return _mm512_castsi512_ps(a); }
+SP_INLINE SIMD_FN nint i_shr1(nint a) { return _mm512_srai_epi32(a, 1); }
+SP_INLINE SIMD_FN nint i_add_where(nint a, nmask m, nint b) { return _mm512_mask_add_epi32(a, m, a, b); }
+SP_INLINE SIMD_FN nint i_sub_where(nint a, nmask m, nint b) { return _mm512_mask_sub_epi32(a, m, a, b); }
+/* Two blocks of double lanes as NBLOCK int32 (integral, in range) or floats (rounded). */
+SP_INLINE SIMD_FN nint i_from_pair(vec a, vec b)
+{
+    return _mm512_inserti64x4(_mm512_castsi256_si512(_mm512_cvttpd_epi32(a)), _mm512_cvttpd_epi32(b), 1);
+}
+SP_INLINE SIMD_FN nvec f_from_pair(vec a, vec b)
+{
+    return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(a)), _mm512_cvtpd_ps(b), 1);
+}
+/* The inverse for int32: NBLOCK int32 lanes as two blocks of doubles (exact). */
+SP_INLINE SIMD_FN void v_from_i_pair(nint a, vec* first, vec* second)
+{
+    *first = _mm512_cvtepi32_pd(_mm512_castsi512_si256(a));
+    *second = _mm512_cvtepi32_pd(_mm512_extracti64x4_epi64(a, 1));
+}
 
 /* floor(a / 9) for 0 <= a < 2^33, as the AVX2 path (codec_oss_prim_avx2.h). */
 SP_INLINE SIMD_FN nint i_div9(nint a)

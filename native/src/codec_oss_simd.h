@@ -38,6 +38,11 @@
  *   i_to_f (convert), i_trunc (convert toward 0), f_as_i / i_as_f (reinterpret),
  *   load_codes32(codes, check) (the low halves of NBLOCK codes, each checked <= max_code,
  *   which is below 2^31 there), store_weights32 (as store_weights, of the scale)
+ * and for K = 4 with the rows in 32-bit lanes (double lanes' results moved between the two):
+ *   i_shr1 (arithmetic >> 1), i_add_where / i_sub_where(a, m, b) (a + b, a - b where m),
+ *   i_from_pair(a, b) / f_from_pair(a, b) (two blocks of doubles as NBLOCK int32, integral and in
+ *   range, or floats, rounded), v_from_i_pair(a, &first, &second) (the inverse for int32), and
+ *   the wide driver's u_load and v_from_u (codes below 2^52 as doubles)
  * and SIMD_NAME(name), the entry points' names. The functions return how many leading vertices
  * they handled (whole blocks); the caller's scalar loop does the rest.
  *
@@ -403,6 +408,14 @@ SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bo
  * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
  * and then (k, row, i) is the one tuple whose index is code. */
+/* `blocks` blocks of codes into `code`, each checked against max_code: 0 where one is above it. */
+SP_INLINE SIMD_FN int load_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, vec* code)
+{
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) code[b] = load_codes(codes + b * BLOCK, &check);
+    return check_passed(&check);
+}
+
 SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t blocks,
                                    float* weights, uint32_t k, const simd_layout* layout)
 {
@@ -411,9 +424,7 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants,
     vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
     root z[DECODE_CHUNK];
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
-    code_check check = check_start(codec->max_code);
-    for (size_t b = 0; b < blocks; ++b) rest[b] = load_codes(codes + b * BLOCK, &check);
-    if (!check_passed(&check)) return 0; /* nothing written yet */
+    if (!load_chunk(codec, codes, blocks, rest)) return 0; /* nothing written yet */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = layer_argument(n, rest[b]);
@@ -484,21 +495,27 @@ SP_INLINE SIMD_FN nvec n_root_step(nvec x, nvec z)
     return f_fmadd(f_mul(z, r), f_fmadd(r, f_splat(2.0f / 9.0f), f_splat(1.0f / 3.0f)), z);
 }
 
+/* A first z ~ x^(-1/3) (x >= 1). */
+SP_INLINE SIMD_FN nvec n_root_start(nvec x)
+{
+    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
+    return n_root_step(x, i_as_f(i_sub(i_splat(1419916032), third)));
+}
+
 /* The layer root's argument x for each code (layer_argument) and a first z ~ x^(-1/3). */
 SP_INLINE SIMD_FN nvec n_layer_start(double n, nint code, nvec* z)
 {
     double m = n + 1;
     nvec x = f_fnmadd(i_to_f(code), f_splat(144.0f), f_splat((float)(8 * m * m * m + 12 * m * m - 106)));
-    nint third = i_trunc(f_mul(i_to_f(f_as_i(x)), f_splat(1.0f / 3.0f)));
-    *z = n_root_step(x, i_as_f(i_sub(i_splat(1419916032), third)));
+    *z = n_root_start(x);
     return x;
 }
 
-/* The layer of each code from x and z, as layer_estimate. */
-SP_INLINE SIMD_FN nint n_layer_finish(double n, nvec x, nvec z)
+/* The layer of each code from x and z, as layer_estimate, taken `low` layers lower. */
+SP_INLINE SIMD_FN nint n_layer_finish(double n, nvec x, nvec z, double low)
 {
     z = n_root_step(x, z);
-    nvec estimate = f_fnmadd(f_fmadd(f_mul(x, z), z, z), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4)));
+    nvec estimate = f_fnmadd(f_fmadd(f_mul(x, z), z, z), f_splat(0.25f), f_splat((float)((2 * n + 3) / 4 - low)));
     return i_min(i_max(i_trunc(estimate), i_splat(0)), i_splat((int32_t)(((uint64_t)n + 1) / 2 - 1)));
 }
 
@@ -519,6 +536,17 @@ SP_INLINE SIMD_FN nint n_row_estimate(nint apex, nint w)
     return i_max(i_trunc(f_mul(f_sub(i_to_f(apex), root), f_splat(1.0f / 3.0f))), i_splat(0)); /* NaN: 0 */
 }
 
+/* sp_oss_unpack's sorted grid components from the layer (K = 4), row j and offset i, as
+ * unpacked_block: integers below 2^31. */
+SP_INLINE SIMD_FN void n_components(double n, uint32_t k, nint layer, nint row, nint i, nint* q)
+{
+    if (k == 4) q[3] = layer;
+    q[2] = k == 4 ? i_add(row, layer) : row;
+    q[1] = i_add(i, q[2]);
+    nint sum = i_add(q[1], q[2]);
+    q[0] = i_sub(i_splat((int32_t)(2 * (n - 1))), k == 4 ? i_add(sum, layer) : sum);
+}
+
 /* Grid components of one block from layer, row estimate and rest (row_offset's check: the lanes
  * where i = w - s_B(j) is not in [0, (2B - 3j) / 2) come back as bits). */
 SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex, nint row, nint w, nint* q)
@@ -527,11 +555,7 @@ SP_INLINE SIMD_FN unsigned n_unpack(double n, uint32_t k, nint layer, nint apex,
     nint i = i_sub(w, n_row_base(apex, three_j, row));
     nint last = i_sub(i_sub(apex, i_splat(3)), three_j); /* 2B - 2 - 3j */
     unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i_add(i, i), last)));
-    if (k == 4) q[3] = layer;
-    q[2] = k == 4 ? i_add(row, layer) : row;
-    q[1] = i_add(i, q[2]);
-    nint sum = i_add(q[1], q[2]);
-    q[0] = i_sub(i_splat((int32_t)(2 * (n - 1))), k == 4 ? i_add(sum, layer) : sum);
+    n_components(n, k, layer, row, i, q);
     return missed;
 }
 
@@ -553,7 +577,7 @@ SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* con
     }
     if (!check_passed(&check)) return 0; /* nothing written yet */
     if (k == 4)
-        for (size_t b = 0; b < blocks; ++b) layer[b] = n_layer_finish(n, x[b], z[b]);
+        for (size_t b = 0; b < blocks; ++b) layer[b] = n_layer_finish(n, x[b], z[b], 0.0);
     for (size_t b = 0; b < blocks; ++b) { /* the layer base in a stage of its own: the root's chain is long */
         apex[b] = i_splat((int32_t)(2 * n + 1));
         if (k == 4) {
@@ -575,15 +599,128 @@ SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* con
 
 DEFINE_DECODE_WALK(decode_walk_narrow, decode_chunk_narrow, NBLOCK, NARROW_CHUNK, 0)
 
-/* The narrow chunks up to the first one holding an invalid code (narrow codecs), then the
- * double lanes from there to the end or to the block holding it. */
+/* ---- K = 4 decode with the rows in 32-bit lanes ----------------------------------------- */
+
+/*
+ * Past the narrow lanes, K = 4 codes need the layer base u(k) (up to 2^45) and the rest
+ * w = code - u(k) in double lanes, but the in-layer index w < S(N) = (N^2 + N + 1) / 3 fits
+ * int32 up to N = SPLIT_MAX_N4 (the GPU decoders' split: the layer step wide, the in-layer
+ * search narrow), so everything else runs in NBLOCK float / int32 lanes, twice as many an
+ * operation as doubles:
+ *   - the layer: the estimate of decode_chunk (layer_argument, exact in double, then rounded)
+ *     by the narrow lanes' float root (n_root_start, n_layer_finish), ~3e-3 of a layer at the
+ *     largest N: codes that close to a layer boundary land in the wrong layer, and the row check
+ *     sends them to the scalar code (under callgrind, of 200 000 codes at 32/38/44 bits: 28,
+ *     142, 445 of the bench's mix and 29, 87, 336 random ones, against 0, 32, 120 and 0, 56,
+ *     194 of the double root's; settling them by a step up cost more than their redo);
+ *   - the row: the root's argument apex^2 + 3 - 12 (w + 7/8), exact in double, rounded to
+ *     float; the float root is good to ~0.02 of a row (apex < 2^18), so the estimate taken half
+ *     a row low and floored is the row j or j - 1, and one exact compare going up settles it;
+ *   - the exact check of the narrow lanes (0 <= i < the row's length) proves (k, j, i), as in
+ *     decode_chunk, and the weights are store_weights32's (q <= s < 2^18).
+ * Every int32 intermediate stays below 2^31: w is clamped to [-1, 2^31 - 1] first (a rest
+ * outside the layer stays outside every layer's triangle, S(N) <= 2^31 - 1), the estimate is
+ * at most rows (<= apex / 3 - 1/2 + 1/6), where the row base
+ * s_B(j) = j (B - j) + floor((j + 1) / 2) ceil((j + 1) / 2) <= S(N) is a sum of two products
+ * below 2^31.
+ */
+#define SPLIT_MAX_N4 80264 /* the largest N with (N^2 + N + 1) / 3 <= 2^31 - 1 */
+
+SP_INLINE int split_decode(const sp_codec* codec, uint32_t k)
+{
+    return k == 4 && codec->n > NARROW_MAX_N4 && codec->n <= SPLIT_MAX_N4;
+}
+
+/* One block's rest w = code - u(k) (exact in double: integers below 2^50), clamped to
+ * [-1, 2^31 - 1], and the row root's argument apex^2 + 3 - 12 (w + 7/8) with
+ * apex = 2 (N - 2k) + 1 (exact below 2^36). */
+SP_INLINE SIMD_FN vec split_rest(double n, vec code, vec layer, vec* mirrored)
+{
+    vec w = v_sub(code, layer_base(n, layer));
+    w = v_min(v_max(w, v_splat(-1.0)), v_splat(2147483647.0));
+    vec apex = v_fnmadd(layer, v_splat(4.0), v_splat(2 * n + 1));
+    *mirrored = v_fnmadd(w, v_splat(12.0), v_fmsub(apex, apex, v_splat(7.5)));
+    return w;
+}
+
+/* The row estimate of w in layer k's triangle (bottom B = N - 2k) from the float root: half a
+ * row low, so the row j or j - 1 (0 for NaN, where w is past the triangle). */
+SP_INLINE SIMD_FN nint split_row_estimate(nint bottom, nvec mirrored)
+{
+    nvec apex = f_fmadd(i_to_f(bottom), f_splat(2.0f), f_splat(1.0f));
+    nvec estimate = f_fmadd(f_sub(apex, f_sqrt(mirrored)), f_splat(1.0f / 3.0f), f_splat(-0.5f));
+    return i_max(i_trunc(estimate), i_splat(0));
+}
+
+/* The row j of w from its estimate (j or j - 1) by one step up, the offset i in it and the
+ * components into q; returns the lanes whose (j, i) is not proven (i outside the row), as bits. */
+SP_INLINE SIMD_FN unsigned split_unpack(double n, nint layer, nint bottom, nint j, nint w, nint* q)
+{
+    nint one = i_splat(1), room = i_sub(bottom, j), half = i_shr1(i_add(j, one)), half_up = i_shr1(i_add(j, i_splat(2)));
+    nint i = i_sub(w, i_add(i_mullo(j, room), i_mullo(half, half_up)));
+    nint last = i_sub(i_sub(room, one), half); /* row j's last offset, B - 1 - j - ceil(j / 2) */
+    nmask above = i_gt(i, last);
+    i = i_sub_where(i, above, i_add(last, one));
+    j = i_add_where(j, above, one);
+    last = i_sub(i_sub(i_sub(bottom, j), one), i_shr1(i_add(j, one)));
+    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i, last)));
+    n_components(n, 4, layer, j, i, q);
+    return missed;
+}
+
+/* K = 4 decode of `blocks` NBLOCK-lane blocks (up to SPLIT_CHUNK, 2 BLOCK double blocks each)
+ * in stages (the layer root's two halves, the rests, the row root, the rest), then the scalar
+ * redo; nothing written where a code is above max_code (returns 0). */
+#define SPLIT_CHUNK DECODE_CHUNK /* 8 ran ~2% slower (both ISAs), 4 ~10% */
+
+SP_INLINE SIMD_FN int decode_chunk_split(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
+{
+    (void)constants;
+    double n = (double)codec->n, scale = (double)codec->scale;
+    nint rest[SPLIT_CHUNK], layers[SPLIT_CHUNK], bottom[SPLIT_CHUNK], row[SPLIT_CHUNK];
+    nvec mirrored[SPLIT_CHUNK], x[SPLIT_CHUNK], z[SPLIT_CHUNK];
+    unsigned missed[SPLIT_CHUNK], any = 0; /* lanes as bits */
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) { /* loaded again for the rests: a smaller frame ran ~5% faster */
+        vec first = load_codes(codes + b * NBLOCK, &check), second = load_codes(codes + b * NBLOCK + BLOCK, &check);
+        x[b] = f_from_pair(layer_argument(n, first), layer_argument(n, second));
+        z[b] = n_root_start(x[b]);
+    }
+    if (!check_passed(&check)) return 0; /* nothing written yet */
+    for (size_t b = 0; b < blocks; ++b) layers[b] = n_layer_finish(n, x[b], z[b], 0.0);
+    for (size_t b = 0; b < blocks; ++b) {
+        vec low, high, first, second;
+        v_from_i_pair(layers[b], &low, &high);
+        rest[b] = i_from_pair(split_rest(n, v_from_u(u_load(codes + b * NBLOCK)), low, &first),
+                              split_rest(n, v_from_u(u_load(codes + b * NBLOCK + BLOCK)), high, &second));
+        mirrored[b] = f_from_pair(first, second);
+    }
+    for (size_t b = 0; b < blocks; ++b) { /* a stage of its own: the root's chain is long */
+        bottom[b] = i_sub(i_splat((int32_t)n), i_add(layers[b], layers[b])); /* B = N - 2k */
+        row[b] = split_row_estimate(bottom[b], mirrored[b]);
+    }
+    for (size_t b = 0; b < blocks; ++b) {
+        nint q[SP_MAX_INFLUENCES];
+        any |= missed[b] = split_unpack(n, layers[b], bottom[b], row[b], rest[b], q);
+        store_weights32(q, k, scale, layout, weights + b * NBLOCK * k);
+    }
+    if (any) redo_decode(codec, codes, blocks, NBLOCK, missed, k, weights);
+    return 1;
+}
+
+DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0)
+
+/* The narrow chunks (narrow codecs) or the split ones (K = 4 up to SPLIT_MAX_N4) up to the
+ * first one holding an invalid code, then the double lanes from there to the end or to the
+ * block holding it. */
 SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                        size_t count, float* weights, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    size_t v = narrow_decode(codec, k)
-                   ? decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout)
-                   : 0;
+    size_t v = 0;
+    if (narrow_decode(codec, k)) v = decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout);
+    else if (split_decode(codec, k)) v = decode_walk_split(codec, constants, codes, 0, count, weights, k, &layout);
     return decode_walk(codec, constants, codes, v, count, weights, k, &layout);
 }
 

@@ -15,8 +15,9 @@
  * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
  * (wide_argument), so they are exact where small (near the apex, where a rounded code would
  * cancel) and rounded once where large (where that moves the root by far less than a step). An
- * estimate is then settled with exact compares; a lane that is still off (or whose rounding
- * leaves the exact regime, as in codec_oss_simd.h) is redone by the scalar code.
+ * estimate is then settled (K = 3 rows) or checked with exact compares; a lane that is still off
+ * (or whose rounding leaves the exact regime, as in codec_oss_simd.h) is redone by the scalar
+ * code.
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN), on top of the
  * double-lane primitives of codec_oss_simd.h:
@@ -48,7 +49,7 @@ typedef struct wide_codec {
     double n, scale;          /* N and the grid 2(N - 1), rounded for K = 2 */
     uint64_t n_bits, scale_bits;
     double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
-    double apex, last_row, last_layer;
+    double apex, last_row;
     uint64_t rows;            /* (2N + 1) / 3 (K = 3) */
     uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
     uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
@@ -72,7 +73,7 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     sp_u128 square = sp_u128_add_u64(sp_u128_mul(sp_u128_from(apex), sp_u128_from(apex)), 3);
     split_exactly(square, &c.mirrored_high, &c.mirrored_low);
     c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
-    c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1), c.last_layer = (double)((n + 1) / 2 - 1);
+    c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1);
     c.rows = (2 * n + 1) / 3;
     c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
     sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
@@ -117,15 +118,6 @@ SP_INLINE SIMD_FN uvec wide_layer_base(const wide_codec* c, uvec k)
     a = u_add(u_mul_u32(a, k), u_splat(c->layer_c0));
     a = u_add(u_mul_u32(a, k), u_splat(2));
     return u_mul(u_sub(a, r), u_splat(INVERSE_OF_9));
-}
-
-/* Codes in layer k, u(k + 1) - u(k) = (b^2 + b + 1) / 3 with b = N - 2k < 2^23, as
- * floor((b (b + 1) + 3/2) / 3): exact below 2^50, and the quotient lies at least 1/6 from an
- * integer, far more than the product with the rounded 1/3 is off. */
-SP_INLINE SIMD_FN vec wide_layer_length(double n, vec k)
-{
-    vec b = v_fnmadd(k, v_splat(2.0), v_splat(n));
-    return v_floor(v_mul(v_fmadd(b, v_add(b, v_splat(1.0)), v_splat(1.5)), v_splat(1.0 / 3.0)));
 }
 
 /* high + low - factor a for a code a (factor 12 or 144, high + low < 2^73 from split_exactly):
@@ -295,12 +287,16 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
 /* ---- decode ----------------------------------------------------------------------------- */
 
 /*
- * The estimates here are taken half a row or layer low: the rounded roots are off by far less
- * than half a step (K = 3: ~1e-5 of a row, from the argument's and the square root's rounding at
- * 2^-52 of values up to 2^34; K = 4: AVX-512's root and AVX2's after its Newton step, no lane of
- * the tests' tens of millions missed), so floored, an estimate is the step or the one before it,
- * and one compare going up settles it. Lanes it does not settle fail the exact checks, whatever
- * the estimate was (checked with estimates biased by two steps and more), and are redone.
+ * K = 3's row estimate is taken half a row low: the rounded root is off by far less than half a
+ * step (~1e-5 of a row, from the argument's and the square root's rounding at 2^-52 of values up
+ * to 2^34), so floored, it is the row or the one before it, and one compare going up settles it.
+ * K = 4's layer estimate is taken as codec_oss_simd.h takes it, unbiased (AVX-512's root and
+ * AVX2's after its Newton step are off by far less than half a layer: no lane of the tests' tens
+ * of millions missed by more), without a settling step: the rare code that close to a layer
+ * boundary lands in the wrong layer, and the row check sends it to the scalar code (a step up
+ * settled every lane but cost ~10% of the decode, on the bench's mix and on random codes alike).
+ * Lanes the checks reject are redone, whatever the estimate was (checked with estimates biased
+ * by two steps and more).
  */
 
 /* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
@@ -334,10 +330,10 @@ SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, uvec code)
     return wide_argument(c->root_high, c->root_low, 144.0, code);
 }
 
-/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate), half a layer low, from its
- * root t of t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the
- * widest codes (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic
- * first (its cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
+/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate) from its root t of
+ * t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the widest codes
+ * (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic first (its
+ * cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
 SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
 {
     if (WIDE_ROOT_NEWTON) {
@@ -345,20 +341,16 @@ SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
         vec excess = v_fmsub(t, v_sub(square, v_splat(3.0)), x);
         t = v_sub(t, v_div(excess, v_fmsub(square, v_splat(3.0), v_splat(3.0))));
     }
-    return clamp_floor(v_fnmadd(t, v_splat(0.25), v_splat((2 * c->n + 3) / 4 - 0.5)), v_splat(c->last_layer));
+    return layer_estimate(c->n, t);
 }
 
-/* K = 4: rest = code - u(k) for the estimated layer k (k or k - 1), one step up, in double
- * lanes: exact below 2^52, and a rest past that (a layer estimate off by more than the bound, or
- * a negative rest, which wraps) stays past every layer's codes, rounded as it may be. The row
- * check then proves the layer: it accepts only a rest inside the layer's triangle. */
-SP_INLINE SIMD_FN vec wide_settle_layer(const wide_codec* c, uvec code, vec* layer)
+/* K = 4: rest = code - u(k) for the estimated layer k in double lanes: exact below 2^52, and a
+ * rest past that (a wrong layer estimate: a negative rest wraps) stays past every layer's codes,
+ * rounded as it may be. The row check then proves the layer: it accepts only a rest inside the
+ * layer's triangle. */
+SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, uvec code, vec layer)
 {
-    vec rest = v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(*layer))));
-    vec length = wide_layer_length(c->n, *layer);
-    mask above = m_ge(rest, length);
-    *layer = v_add_where(*layer, above, v_splat(1.0));
-    return v_sub(rest, v_add_where(v_zero(), above, length));
+    return v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(layer))));
 }
 
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
@@ -383,7 +375,7 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
         }
         for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
         for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_settle_layer(c, u_load(codes + b * BLOCK), &layer[b]);
+            rest[b] = wide_layer_rest(c, u_load(codes + b * BLOCK), layer[b]);
             bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
         }
         for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */

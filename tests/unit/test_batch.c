@@ -81,13 +81,14 @@ static void random_tuples(void)
 }
 
 /* N at and just past the largest the vector paths accept (exact there, scalar beyond), and the
- * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024; double lanes beyond), and
+ * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024, and K = 4 with the rows in
+ * 32-bit lanes: 80264; double lanes beyond), and
  * codes at every layer and row start/end there, where the root estimates are off by one, and
  * the last codes, where the layer estimate's cube root argument is smallest. */
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}, {3, 8192}, {4, 1024}};
+        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}, {3, 8192}, {4, 1024}, {4, 80264}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -139,18 +140,53 @@ static void estimate_boundaries(void)
     }
 }
 
+/* K = 4 with the rows in 32-bit lanes (N = 1025 .. 80264): every row's first and last codes
+ * (and their neighbours) in the first layers, one in the middle and the last ones, where the
+ * float row estimate, taken half a row low, is closest to two rows off, and the int32 row
+ * bases and offsets are largest (layer 0 of N = 80264: S = 2^31 - 1.8e5). */
+static void split_row_boundaries(void)
+{
+    static const uint64_t ns[] = {1025, 4258, 17038, 68158, 80264};
+    for (size_t e = 0; e < sizeof(ns) / sizeof(ns[0]); ++e) {
+        uint64_t n = ns[e], last_layer = (n + 1) / 2 - 1;
+        const uint64_t layers[] = {0, 1, 2, last_layer / 2, last_layer - 2, last_layer - 1, last_layer};
+        sp_codec c = oss(4, n);
+        uint64_t* codes = malloc(((2 * n + 1) / 3 + 1) * 4 * sizeof(uint64_t));
+        for (size_t l = 0; l < sizeof(layers) / sizeof(layers[0]); ++l) {
+            uint64_t base = sp_oss_layer_base(n, layers[l]), bottom = n - 2 * layers[l], rows = (2 * bottom + 1) / 3;
+            size_t count = 0;
+            for (uint64_t j = 0; j <= rows; ++j) {
+                uint64_t start = base + sp_oss_row_base(bottom, j);
+                for (uint64_t d = 0; d < 4; ++d) /* start - 2 .. start + 1 */
+                    if (start + d >= 2 && start + d - 2 <= c.max_code) codes[count++] = start + d - 2;
+            }
+            if (compare_decode(&c, codes, count, "split row boundary decode")) break;
+        }
+        free(codes);
+    }
+}
+
 /* Every weight q / s the 32-bit lanes compute (every q <= s = 2(N - 1) of every N they take,
- * K = 3 up to 8192, K = 4 up to 1024): the first row of the first layer, codes 0..N - 1, holds
- * q1 = 0..N - 1 and q0 = N - 1..s, so it reaches every q. */
+ * K = 3 up to 8192, K = 4 up to 1024; with the rows in 32-bit lanes, K = 4 up to 80264, every q
+ * of the first N past the narrow lanes, of the bench's 32/38/44-bit N, of the largest and of
+ * 200 random N between): the first row of the first layer, codes 0..N - 1, holds q1 = 0..N - 1
+ * and q0 = N - 1..s, so it reaches every q. */
 static void narrow_weights(void)
 {
-    uint64_t* codes = malloc(8192 * sizeof(uint64_t));
-    for (uint64_t v = 0; v < 8192; ++v) codes[v] = v;
+    enum { SPLIT_LARGEST = 80264 };
+    uint64_t* codes = malloc(SPLIT_LARGEST * sizeof(uint64_t));
+    for (uint64_t v = 0; v < SPLIT_LARGEST; ++v) codes[v] = v;
     for (uint32_t k = 3; k <= 4; ++k)
         for (uint64_t n = 2; n <= (k == 3 ? 8192u : 1024u); ++n) {
             sp_codec c = oss(k, n);
             if (compare_decode(&c, codes, (size_t)n, "narrow weights")) break;
         }
+    static const uint64_t split[] = {1025, 1026, 4258, 17038, 68158, SPLIT_LARGEST - 1, SPLIT_LARGEST};
+    for (size_t i = 0; i < sizeof(split) / sizeof(split[0]) + 200; ++i) {
+        uint64_t n = i < sizeof(split) / sizeof(split[0]) ? split[i] : 1025 + rng_next() % (SPLIT_LARGEST - 1024);
+        sp_codec c = oss(4, n);
+        if (compare_decode(&c, codes, (size_t)n, "split weights")) break;
+    }
     free(codes);
 }
 
@@ -232,14 +268,17 @@ static void invalid_codes(void)
 }
 
 /* The vertices each path takes in a batch of 23 (the scalar loop does the rest): a path that
- * silently did nothing would pass every comparison above. */
+ * silently did nothing would pass every comparison above. K = 4 at 32 bits: the rows in 32-bit
+ * lanes (one NBLOCK block, then the double lanes). */
 static void path_coverage(sp_isa isa)
 {
+    static const struct { uint32_t k, bits; } cases[] = {{2, 22}, {3, 22}, {4, 22}, {4, 32}};
     float w[23 * 4];
     uint64_t codes[23];
-    for (uint32_t k = 2; k <= 4; ++k) {
+    for (size_t e = 0; e < sizeof(cases) / sizeof(cases[0]); ++e) {
         sp_codec c;
-        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 22, &c) == SP_OK);
+        uint32_t k = cases[e].k;
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, cases[e].bits, &c) == SP_OK);
         for (size_t v = 0; v < 23; ++v) random_tuple(k, c.scale, w + v * k);
         size_t expected = 0;
         sp_isa cpu = sp_cpu_isa();
@@ -283,6 +322,7 @@ int main(void)
         odd_weights();
         range_edges();
         estimate_boundaries();
+        split_row_boundaries();
         narrow_weights();
         random_tuples();
     }
