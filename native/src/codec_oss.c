@@ -173,32 +173,49 @@ SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const u
     return layer_base + row_base + (q[1] - q[2]);
 }
 
+/* One vertex of oss_encode_chunks: w and scale are its weights as doubles and its grid scale
+ * (sp_grid_load), loaded a vertex before; loads the next vertex's (or its own again for the
+ * last) into next and returns their scale. The grid s comes as a value (also as a double), not
+ * read through codec, which the stores to codes might alias. */
+SP_INLINE double oss_encode_vertex(const sp_codec* codec, const oss_pack_form* form, uint64_t s, double grid,
+                                   const float* weights, size_t v, size_t count, const double* w, double scale,
+                                   double* next, uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
+{
+    const float* vertex = weights + v * k;
+    double next_scale = sp_grid_load(v + 1 < count ? vertex + k : vertex, k, grid, next);
+    uint64_t q[SP_MAX_INFLUENCES];
+    if (!sp_grid_round(vertex, w, k, s, scale, q)) {
+        codes[v] = sp_oss_encode_one(codec, vertex, significant ? significant + v : NULL);
+        return next_scale;
+    }
+    if (significant) significant[v] = sp_grid_significant(q, k);
+    codes[v] = form_kind == OSS_FORM_GENERAL ? oss_pack(form->n, k, q)
+                                             : oss_pack_small(form, k, q, form_kind == OSS_FORM_MODULAR);
+    return next_scale;
+}
+
 /* The vertices first..count-1 with k constant, so the rounding and the index unroll into
- * straight-line code with q in registers: the index in the given OSS_FORM_*. Vertices the double rounding does not
- * settle take sp_oss_encode_one. Software-pipelined: each vertex's weights are loaded and its
- * grid scale divided one vertex ahead, so the division (the end of a long chain) overlaps the
- * previous vertex's rounding and index, and the weights are converted to double once. */
+ * straight-line code with q in registers: the index in the given OSS_FORM_*. Vertices the
+ * double rounding does not settle take sp_oss_encode_one. Software-pipelined: each vertex's
+ * weights are loaded and its grid scale divided one vertex ahead, so that the division (the end
+ * of a long chain) overlaps the previous vertex's rounding and index, and the weights are
+ * converted to double once; two vertices a turn, so that the two sets of loaded weights take
+ * turns in registers instead of being copied. */
 SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, size_t first, size_t count,
                                  uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
 {
-    uint64_t n = codec->n, s = codec->scale;
-    oss_pack_form form = pack_form(n);
+    oss_pack_form form = pack_form(codec->n);
+    uint64_t s = codec->scale;
+    double grid = (double)s;
     if (first >= count) return;
-    double next[SP_MAX_INFLUENCES], next_scale = sp_grid_load(weights + first * k, k, (double)s, next);
-    for (size_t v = first; v < count; ++v) {
-        double w[SP_MAX_INFLUENCES], scale = next_scale;
-        SP_UNROLL for (uint32_t i = 0; i < k; ++i) w[i] = next[i];
-        size_t ahead = v + 1 < count ? v + 1 : v; /* the last vertex loads itself again */
-        next_scale = sp_grid_load(weights + ahead * k, k, (double)s, next);
-        const float* vertex = weights + v * k;
-        uint64_t q[SP_MAX_INFLUENCES];
-        if (!sp_grid_round(vertex, w, k, s, scale, q)) {
-            codes[v] = sp_oss_encode_one(codec, vertex, significant ? significant + v : NULL);
-            continue;
-        }
-        if (significant) significant[v] = sp_grid_significant(q, k);
-        codes[v] = form_kind == OSS_FORM_GENERAL ? oss_pack(n, k, q)
-                                                 : oss_pack_small(&form, k, q, form_kind == OSS_FORM_MODULAR);
+    double even[SP_MAX_INFLUENCES], odd[SP_MAX_INFLUENCES];
+    double even_scale = sp_grid_load(weights + first * k, k, grid, even), odd_scale;
+    for (size_t v = first; v < count; v += 2) {
+        odd_scale = oss_encode_vertex(codec, &form, s, grid, weights, v, count, even, even_scale, odd, codes,
+                                      significant, k, form_kind);
+        if (v + 1 == count) break;
+        even_scale = oss_encode_vertex(codec, &form, s, grid, weights, v + 1, count, odd, odd_scale, even, codes,
+                                       significant, k, form_kind);
     }
 }
 
