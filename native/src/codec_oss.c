@@ -133,14 +133,18 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
  * modulo 2^64 is the product with 9's inverse, and a mod 9 depends on k only through k mod 3
  * (layer_remainder; as the wide vector lanes do it, codec_oss_wide_simd.h). That holds for the
  * layers of the tetrahedron, k <= (N + 1)/2; past them (q not sorted, the rounding of unsorted
- * weights) the index is sp_oss_layer_base's, as oss_pack's, whatever it wraps to. */
+ * weights) the index is sp_oss_layer_base's, as oss_pack's, whatever it wraps to. For K = 3 past
+ * OSS_ROW64_N (also OSS_FORM_MODULAR) the row base is s_N(j) = j (N - j) + floor((j + 1)^2 / 4)
+ * (the numerator is 4j (N - j) + (j + 1)^2) modulo 2^64: for every j, past the triangle too,
+ * what sp_oss_row_base gives, the floor by 4 of the same numerator modulo 2^128, taken modulo
+ * 2^64 (2^128 / 4 is a multiple of 2^64). K = 4 grids (N < 2^23) never need it. */
 typedef struct oss_pack_form {
     uint64_t n, layer_linear, layer_constant, row_constant; /* N, -(6N + 9), 3N^2 + 9N + 6, 4N + 2 */
     uint64_t layer_remainder[3]; /* u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
 } oss_pack_form;
 
 /* How the encoder's index is computed: oss_pack (128-bit forms past the 64-bit ones), or
- * oss_pack_small with the layer base's floor by a division or by the exact division. */
+ * oss_pack_small with the 64-bit numerators' floors or with the modulo 2^64 forms. */
 enum { OSS_FORM_GENERAL, OSS_FORM_64, OSS_FORM_MODULAR };
 
 /* 9 u mod 2^64 -> u: 9 * OSS_INVERSE_OF_9 = 1 mod 2^64. */
@@ -161,8 +165,9 @@ static oss_pack_form pack_form(uint64_t n)
 SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const uint64_t* q, int modular)
 {
     if (k == 2) return q[1];
-    uint64_t layer = k == 4 ? q[3] : 0, row = q[2] - layer;
-    uint64_t row_base = ((form->row_constant - 8 * layer - 3 * row) * row + 1) / 4;
+    uint64_t layer = k == 4 ? q[3] : 0, row = q[2] - layer, row_base;
+    if (k == 4 || !modular) row_base = ((form->row_constant - 8 * layer - 3 * row) * row + 1) / 4;
+    else row_base = row * (form->n - row) + ((row + 1) >> 1) * ((row + 2) >> 1);
     uint64_t layer_base = 0;
     if (k == 4) {
         uint64_t numerator = ((4 * layer + form->layer_linear) * layer + form->layer_constant) * layer + 2;
@@ -243,7 +248,7 @@ SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_
             for (size_t v = first; v < count; ++v) codes[v] = sp_oss_encode_one(codec, weights + v * k, significant ? significant + v : NULL);
     } else if (codec->n < (k == 4 ? OSS_LAYER64_N : OSS_ROW64_N))
         oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_64);
-    else if (k == 4 && codec->n < OSS_ROW64_N)
+    else if (k == 3 || (k == 4 && codec->n < OSS_ROW64_N))
         oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_MODULAR);
     else
         oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_GENERAL);

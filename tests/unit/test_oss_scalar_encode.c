@@ -2,9 +2,9 @@
  * The scalar OSS batch encoder's own forms against the library's general ones (issue 14):
  *   - the K = 4 layer base past 2^21 (N from OSS_LAYER64_N up to the largest 64-bit K = 4 grid)
  *     taken modulo 2^64 with an exact division by 9 and a remainder table by k mod 3, against
- *     sp_oss_pack's 128-bit closed form, for N of each residue mod 3, every layer's neighbourhood
- *     sampled, the top layer, and unsorted weights (layers past the tetrahedron, where the code
- *     wraps as sp_oss_pack's does);
+ *     sp_oss_pack's 128-bit closed form, for N of each residue mod 3, layers up to the top one,
+ *     and unsorted weights (layers past the tetrahedron, where the code wraps as sp_oss_pack's
+ *     does); likewise the K = 3 row base past 2^30 (OSS_ROW64_N) modulo 2^64;
  *   - the rounding's skipped clamps: -0 in place of +0 must not change a code or a count (the
  *     remainders are ranked as bit patterns, where -0 would sort above every remainder).
  * The reference is sp_grid_quantize and sp_oss_pack vertex by vertex; the batch runs the
@@ -20,26 +20,28 @@
 
 #define VERTICES 60000
 
-/* Sorted weights with the smallest one spread over [0, 1/4], so that q3 (the layer) takes every
- * value up to the top layer; a few all equal (the top layer itself) and a few unsorted. */
-static void make_weights(size_t count, float* w)
+/* Sorted k weights with the smallest one spread over [0, 1/k], so that the last q (the layer,
+ * or the row for K = 3) takes every value up to the top one; a few all equal (the top itself)
+ * and a few unsorted. */
+static void make_weights(uint32_t k, size_t count, float* w)
 {
     for (size_t v = 0; v < count; ++v) {
         double raw[4], sum = 0;
-        for (int i = 0; i < 4; ++i) raw[i] = (double)(rng_next() >> 11) * 0x1p-53;
-        for (int i = 1; i < 4; ++i) /* descending */
-            for (int j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
+        for (uint32_t i = 0; i < k; ++i) raw[i] = rng_unit();
+        for (uint32_t i = 1; i < k; ++i) /* descending */
+            for (uint32_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
                 double t = raw[j];
                 raw[j] = raw[j - 1];
                 raw[j - 1] = t;
             }
-        if (v % 97 == 0) raw[0] = raw[1] = raw[2] = raw[3] = 1;
-        for (int i = 0; i < 4; ++i) sum += raw[i];
-        for (int i = 0; i < 4; ++i) w[v * 4 + i] = (float)(raw[i] / sum);
+        if (v % 97 == 0)
+            for (uint32_t i = 0; i < k; ++i) raw[i] = 1;
+        for (uint32_t i = 0; i < k; ++i) sum += raw[i];
+        for (uint32_t i = 0; i < k; ++i) w[v * k + i] = (float)(raw[i] / sum);
         if (v % 89 == 0) { /* unsorted: the largest weight last */
-            float t = w[v * 4];
-            w[v * 4] = w[v * 4 + 3];
-            w[v * 4 + 3] = t;
+            float t = w[v * k];
+            w[v * k] = w[v * k + k - 1];
+            w[v * k + k - 1] = t;
         }
     }
 }
@@ -47,36 +49,40 @@ static void make_weights(size_t count, float* w)
 /* Batch codes and counts (scalar path) against sp_grid_quantize + sp_oss_pack per vertex. */
 static void compare_with_pack(const sp_codec* c, const float* w, size_t count, const char* what)
 {
+    uint32_t k = c->influences;
     uint64_t* codes = malloc(count * sizeof(uint64_t));
     uint8_t* significant = malloc(count);
     CHECK(sp_encode_weights_batch_isa(c, w, count, codes, significant, SP_ISA_SCALAR) == SP_OK);
     int before = check_failures;
     for (size_t v = 0; v < count && check_failures - before < 5; ++v) {
-        uint64_t q[4];
-        sp_grid_quantize(w + v * 4, 4, c->scale, q);
-        uint64_t expected = sp_oss_pack(c->n, 4, q);
-        CHECK_MSG(codes[v] == expected && significant[v] == sp_grid_significant(q, 4),
-                  "%s N=%llu vertex %zu: %llu vs %llu (q %llu %llu %llu %llu)", what, (unsigned long long)c->n, v,
-                  (unsigned long long)codes[v], (unsigned long long)expected, (unsigned long long)q[0],
+        uint64_t q[4] = {0, 0, 0, 0};
+        sp_grid_quantize(w + v * k, k, c->scale, q);
+        uint64_t expected = sp_oss_pack(c->n, k, q);
+        CHECK_MSG(codes[v] == expected && significant[v] == sp_grid_significant(q, k),
+                  "%s K=%u N=%llu vertex %zu: %llu vs %llu (q %llu %llu %llu %llu)", what, k, (unsigned long long)c->n,
+                  v, (unsigned long long)codes[v], (unsigned long long)expected, (unsigned long long)q[0],
                   (unsigned long long)q[1], (unsigned long long)q[2], (unsigned long long)q[3]);
     }
     free(codes), free(significant);
 }
 
-/* Every residue of N mod 3 just past 2^21 (the first grids of the modular form), just below it
- * (the last of the 64-bit form), and the largest K = 4 grids of 64-bit codes. */
-static void layer_forms(void)
+/* Every residue of N mod 3 just past the limit of the 64-bit form (K = 4: 2^21, K = 3: 2^30),
+ * just below it, in between, and the largest grids of 64-bit codes. */
+static void modular_forms(void)
 {
-    sp_codec widest;
-    CHECK(sp_codec_from_bits(SP_METHOD_OSS, 4, 64, &widest) == SP_OK);
-    const uint64_t ns[] = {((uint64_t)1 << 21) - 1, (uint64_t)1 << 21, ((uint64_t)1 << 21) + 1, ((uint64_t)1 << 21) + 2,
-                           3000001, 3000002, 3000003, widest.n - 2, widest.n - 1, widest.n};
     float* w = malloc(VERTICES * 4 * sizeof(float));
-    make_weights(VERTICES, w);
-    for (size_t i = 0; i < sizeof(ns) / sizeof(ns[0]); ++i) {
-        sp_codec c;
-        CHECK(sp_codec_from_params(SP_METHOD_OSS, 4, ns[i], NULL, &c) == SP_OK);
-        compare_with_pack(&c, w, VERTICES, "layer form");
+    for (uint32_t k = 3; k <= 4; ++k) {
+        sp_codec widest;
+        CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, 64, &widest) == SP_OK);
+        uint64_t limit = (uint64_t)1 << (k == 4 ? 21 : 30), middle = (limit + widest.n) / 2;
+        const uint64_t ns[] = {limit - 1, limit, limit + 1, limit + 2, middle, middle + 1, middle + 2,
+                               widest.n - 2, widest.n - 1, widest.n};
+        make_weights(k, VERTICES, w);
+        for (size_t i = 0; i < sizeof(ns) / sizeof(ns[0]); ++i) {
+            sp_codec c;
+            CHECK(sp_codec_from_params(SP_METHOD_OSS, k, ns[i], NULL, &c) == SP_OK);
+            compare_with_pack(&c, w, VERTICES, "modular form");
+        }
     }
     free(w);
 }
@@ -115,7 +121,7 @@ static void negative_zeros(void)
 
 int main(void)
 {
-    layer_forms();
+    modular_forms();
     negative_zeros();
     return check_report("test_oss_scalar_encode");
 }
