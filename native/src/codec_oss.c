@@ -224,14 +224,16 @@ SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, si
     }
 }
 
-/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_quantize (there
- * sp_grid_round_pair, or the general rounding for the pairs it leaves), the code q[1]. */
+/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_quantize's path there,
+ * called directly (sp_grid_round_pair, or the general rounding for the pairs it leaves; 70
+ * instructions a vertex against 76 through sp_grid_quantize), the code q[1]. */
 static void oss_encode_wide_pairs(const sp_codec* codec, const float* weights, size_t first, size_t count,
                                   uint64_t* codes, uint8_t* significant)
 {
     for (size_t v = first; v < count; ++v) {
         uint64_t q[2];
-        sp_grid_quantize(weights + v * 2, 2, codec->scale, q);
+        if (!sp_grid_round_pair(weights + v * 2, codec->scale, q))
+            sp_grid_quantize_general(weights + v * 2, 2, codec->scale, q);
         if (significant) significant[v] = sp_grid_significant(q, 2);
         codes[v] = q[1];
     }
