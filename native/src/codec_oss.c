@@ -123,70 +123,117 @@ uint64_t sp_oss_pack(uint64_t n, uint32_t k, const uint64_t* q)
     return oss_pack(n, k, q);
 }
 
-/* The index of sorted grid coordinates for N below OSS_LAYER64_N (K = 4) or OSS_ROW64_N (K = 2,
- * 3), with the codec's constants taken out of the closed forms: u(k) in Horner form
- * ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 over 9 and s_b(j) for the row's bottom b = N - 2k as
- * ((4N + 2 - 8k - 3j) j + 1) / 4, both modulo 2^64 (their values fit 64 bits, see the 64-bit
- * forms above; negative intermediates wrap and come back). */
+/* The index of sorted grid coordinates for N below OSS_ROW64_N, with the codec's constants taken
+ * out of the closed forms: u(k) in Horner form ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 over 9
+ * and s_b(j) for the row's bottom b = N - 2k as ((4N + 2 - 8k - 3j) j + 1) / 4, both modulo
+ * 2^64 (negative intermediates wrap and come back). The row's numerator fits 64 bits (see the
+ * 64-bit forms above), so its floor is exact. So is the layer's below OSS_LAYER64_N (form
+ * OSS_FORM_64); past it (OSS_FORM_MODULAR) the numerator a wraps, but u(k) < 2^64 (the code
+ * count of a codec is at most 2^64), so u(k) = (a - a mod 9) / 9 is an exact division, which
+ * modulo 2^64 is the product with 9's inverse, and a mod 9 depends on k only through k mod 3
+ * (layer_remainder; as the wide vector lanes do it, codec_oss_wide_simd.h). That holds for the
+ * layers of the tetrahedron, k <= (N + 1)/2; past them (q not sorted, the rounding of unsorted
+ * weights) the index is sp_oss_layer_base's, as oss_pack's, whatever it wraps to. For K = 3 past
+ * OSS_ROW64_N (also OSS_FORM_MODULAR) the row base is s_N(j) = j (N - j) + floor((j + 1)^2 / 4)
+ * (the numerator is 4j (N - j) + (j + 1)^2) modulo 2^64: for every j, past the triangle too,
+ * what sp_oss_row_base gives, the floor by 4 of the same numerator modulo 2^128, taken modulo
+ * 2^64 (2^128 / 4 is a multiple of 2^64). K = 4 grids (N < 2^23) never need it. */
 typedef struct oss_pack_form {
-    uint64_t layer_linear, layer_constant, row_constant; /* -(6N + 9), 3N^2 + 9N + 6, 4N + 2 */
+    uint64_t n, layer_linear, layer_constant, row_constant; /* N, -(6N + 9), 3N^2 + 9N + 6, 4N + 2 */
+    uint64_t layer_remainder[3]; /* u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
 } oss_pack_form;
+
+/* How the encoder's index is computed: oss_pack (128-bit forms past the 64-bit ones), or
+ * oss_pack_small with the 64-bit numerators' floors or with the modulo 2^64 forms. */
+enum { OSS_FORM_GENERAL, OSS_FORM_64, OSS_FORM_MODULAR };
+
+/* 9 u mod 2^64 -> u: 9 * OSS_INVERSE_OF_9 = 1 mod 2^64. */
+#define OSS_INVERSE_OF_9 0x8E38E38E38E38E39ull
 
 static oss_pack_form pack_form(uint64_t n)
 {
-    oss_pack_form form = {(uint64_t)0 - (6 * n + 9), 3 * n * n + 9 * n + 6, 4 * n + 2};
+    oss_pack_form form = {n, (uint64_t)0 - (6 * n + 9), 3 * n * n + 9 * n + 6, 4 * n + 2, {0, 0, 0}};
+    /* 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 mod 9: the first term is 3 times something taken
+     * mod 3 (N mod 3 and k mod 3 decide it), the second 4k^3 + 6k mod 9, and (k + 3)^3 = k^3
+     * mod 9. */
+    uint64_t n3 = n % 3;
+    for (uint64_t k = 0; k < 3; ++k)
+        form.layer_remainder[k] = (3 * (n3 * k * (n3 + 6 - 2 * k) % 3) + k * (4 * k * k + 6) + 2) % 9;
     return form;
 }
 
-SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const uint64_t* q)
+SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const uint64_t* q, int modular)
 {
     if (k == 2) return q[1];
-    uint64_t layer = k == 4 ? q[3] : 0, row = q[2] - layer;
-    uint64_t row_base = ((form->row_constant - 8 * layer - 3 * row) * row + 1) / 4;
-    uint64_t layer_base =
-        k == 4 ? (((4 * layer + form->layer_linear) * layer + form->layer_constant) * layer + 2) / 9 : 0;
+    uint64_t layer = k == 4 ? q[3] : 0, row = q[2] - layer, row_base;
+    if (k == 4 || !modular) row_base = ((form->row_constant - 8 * layer - 3 * row) * row + 1) / 4;
+    else row_base = row * (form->n - row) + ((row + 1) >> 1) * ((row + 2) >> 1);
+    uint64_t layer_base = 0;
+    if (k == 4) {
+        uint64_t numerator = ((4 * layer + form->layer_linear) * layer + form->layer_constant) * layer + 2;
+        if (!modular) layer_base = numerator / 9;
+        else if (layer <= (form->n + 1) / 2) layer_base = (numerator - form->layer_remainder[layer % 3]) * OSS_INVERSE_OF_9;
+        else layer_base = sp_oss_layer_base(form->n, layer); /* unsorted q: as oss_pack wraps */
+    }
     return layer_base + row_base + (q[1] - q[2]);
 }
 
-/* Vertices per stage of the scalar encoder: the grid scales (a division each, at the end of
- * the sum's chain) of a chunk first, then their roundings and indices, so that the core
- * overlaps the independent divisions instead of waiting for each. */
-#define ENCODE_CHUNK 16
-
-/* One chunk after another with k constant, so the rounding and the index unroll into
- * straight-line code with q in registers: the index by oss_pack_small where `small` (N below
- * the limits of its 64-bit forms), else by oss_pack. Vertices the double rounding does not
- * settle take sp_oss_encode_one. */
-SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, size_t first, size_t count,
-                                 uint64_t* codes, uint8_t* significant, uint32_t k, int small)
+/* One vertex of oss_encode_chunks: w and scale are its weights as doubles and its grid scale
+ * (sp_grid_load), loaded a vertex before; loads the next vertex's (or its own again for the
+ * last) into next and returns their scale. The grid s comes as a value (also as a double), not
+ * read through codec, which the stores to codes might alias. */
+SP_INLINE double oss_encode_vertex(const sp_codec* codec, const oss_pack_form* form, uint64_t s, double grid,
+                                   const float* weights, size_t v, size_t count, const double* w, double scale,
+                                   double* next, uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
 {
-    uint64_t n = codec->n, s = codec->scale;
-    oss_pack_form form = pack_form(n);
-    for (size_t v = first; v < count; v += ENCODE_CHUNK) {
-        double scale[ENCODE_CHUNK];
-        size_t chunk = count - v < ENCODE_CHUNK ? count - v : ENCODE_CHUNK;
-        for (size_t c = 0; c < chunk; ++c) scale[c] = sp_grid_scale(weights + (v + c) * k, k, (double)s);
-        for (size_t c = 0; c < chunk; ++c) {
-            const float* vertex = weights + (v + c) * k;
-            uint64_t q[SP_MAX_INFLUENCES];
-            if (!sp_grid_round(vertex, k, s, scale[c], q)) {
-                codes[v + c] = sp_oss_encode_one(codec, vertex, significant ? significant + v + c : NULL);
-                continue;
-            }
-            if (significant) significant[v + c] = sp_grid_significant(q, k);
-            codes[v + c] = small ? oss_pack_small(&form, k, q) : oss_pack(n, k, q);
-        }
+    const float* vertex = weights + v * k;
+    double next_scale = sp_grid_load(v + 1 < count ? vertex + k : vertex, k, grid, next);
+    uint64_t q[SP_MAX_INFLUENCES];
+    if (!sp_grid_round(vertex, w, k, s, scale, q)) {
+        codes[v] = sp_oss_encode_one(codec, vertex, significant ? significant + v : NULL);
+        return next_scale;
+    }
+    if (significant) significant[v] = sp_grid_significant(q, k);
+    codes[v] = form_kind == OSS_FORM_GENERAL ? oss_pack(form->n, k, q)
+                                             : oss_pack_small(form, k, q, form_kind == OSS_FORM_MODULAR);
+    return next_scale;
+}
+
+/* The vertices first..count-1 with k constant, so the rounding and the index unroll into
+ * straight-line code with q in registers: the index in the given OSS_FORM_*. Vertices the
+ * double rounding does not settle take sp_oss_encode_one. Software-pipelined: each vertex's
+ * weights are loaded and its grid scale divided one vertex ahead, so that the division (the end
+ * of a long chain) overlaps the previous vertex's rounding and index, and the weights are
+ * converted to double once; two vertices a turn, so that the two sets of loaded weights take
+ * turns in registers instead of being copied. */
+SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, size_t first, size_t count,
+                                 uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
+{
+    oss_pack_form form = pack_form(codec->n);
+    uint64_t s = codec->scale;
+    double grid = (double)s;
+    if (first >= count) return;
+    double even[SP_MAX_INFLUENCES], odd[SP_MAX_INFLUENCES];
+    double even_scale = sp_grid_load(weights + first * k, k, grid, even), odd_scale;
+    for (size_t v = first; v < count; v += 2) {
+        odd_scale = oss_encode_vertex(codec, &form, s, grid, weights, v, count, even, even_scale, odd, codes,
+                                      significant, k, form_kind);
+        if (v + 1 == count) break;
+        even_scale = oss_encode_vertex(codec, &form, s, grid, weights, v + 1, count, odd, odd_scale, even, codes,
+                                       significant, k, form_kind);
     }
 }
 
-/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_quantize (there
- * sp_grid_round_pair, or the general rounding for the pairs it leaves), the code q[1]. */
+/* K = 2 codes past 50 bits (grids from SP_GRID_DOUBLE_LIMIT): sp_grid_quantize's path there,
+ * called directly (sp_grid_round_pair, or the general rounding for the pairs it leaves; 70
+ * instructions a vertex against 76 through sp_grid_quantize), the code q[1]. */
 static void oss_encode_wide_pairs(const sp_codec* codec, const float* weights, size_t first, size_t count,
                                   uint64_t* codes, uint8_t* significant)
 {
     for (size_t v = first; v < count; ++v) {
         uint64_t q[2];
-        sp_grid_quantize(weights + v * 2, 2, codec->scale, q);
+        if (!sp_grid_round_pair(weights + v * 2, codec->scale, q))
+            sp_grid_quantize_general(weights + v * 2, 2, codec->scale, q);
         if (significant) significant[v] = sp_grid_significant(q, 2);
         codes[v] = q[1];
     }
@@ -202,9 +249,11 @@ SP_INLINE void oss_encode_run(const sp_codec* codec, const float* weights, size_
         else
             for (size_t v = first; v < count; ++v) codes[v] = sp_oss_encode_one(codec, weights + v * k, significant ? significant + v : NULL);
     } else if (codec->n < (k == 4 ? OSS_LAYER64_N : OSS_ROW64_N))
-        oss_encode_chunks(codec, weights, first, count, codes, significant, k, 1);
+        oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_64);
+    else if (k == 3 || (k == 4 && codec->n < OSS_ROW64_N))
+        oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_MODULAR);
     else
-        oss_encode_chunks(codec, weights, first, count, codes, significant, k, 0);
+        oss_encode_chunks(codec, weights, first, count, codes, significant, k, OSS_FORM_GENERAL);
 }
 
 void sp_oss_encode_scalar(const sp_codec* codec, const float* weights, size_t first, size_t count, uint64_t* codes,
