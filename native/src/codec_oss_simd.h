@@ -154,7 +154,7 @@ SP_INLINE SIMD_FN vec layer_base(double n, vec k)
 
 /* ---- encode ----------------------------------------------------------------------------- */
 
-/* sp_grid_scale in lanes (the same sum from w0, the same division): a stage of its own, as the
+/* sp_grid_load's scale in lanes (the same sum from w0, the same division): a stage of its own, as the
  * division ends a chain. */
 SP_INLINE SIMD_FN vec quantize_scale(const vec* w, uint32_t k, double s)
 {
