@@ -146,6 +146,9 @@ SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 }
 
 /* Component i of eight consecutive vertices of k weights, widened to double (exact). */
+#define LOAD_ORDERED 0 /* the driver's weights_ordered serves */
+SP_INLINE SIMD_FN unsigned load_weights_ordered(const float* w, vec* x) { (void)w, (void)x; return 0; } /* unused */
+
 SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layout* layout, vec* x)
 {
     __m512 lo = _mm512_loadu_ps(w), hi = _mm512_loadu_ps(w + 8 * k - 16);
@@ -241,6 +244,13 @@ SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)
 SP_INLINE SIMD_FN void store_codes(uint64_t* codes, vec x)
 {
     _mm512_storeu_si512(codes, _mm512_cvttpd_epu64(x));
+}
+
+/* Lanes ROUNDING_MAGIC + code (codec_oss_simd.h: 1.5 2^52 plus an integer of magnitude below
+ * 2^51) as the u64 codes: the difference of the bits. */
+SP_INLINE SIMD_FN void store_biased_codes(uint64_t* codes, vec x)
+{
+    _mm512_storeu_si512(codes, _mm512_sub_epi64(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52))));
 }
 
 SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)

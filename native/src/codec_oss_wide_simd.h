@@ -188,9 +188,8 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
-        load_weights(weights + b * BLOCK * k, k, layout, w[b]);
-        scale[b] = quantize_scale(w[b], k, c->scale);
-        ordered[b] = weights_ordered(w[b], k);
+        prefetch_block(weights + b * BLOCK * k, k, codes + b * BLOCK);
+        ordered[b] = load_block(weights + b * BLOCK * k, k, layout, c->scale, w[b], &scale[b]);
     }
     if (encode_fused(k))
         for (size_t b = 0; b < blocks; ++b)
