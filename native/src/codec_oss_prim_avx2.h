@@ -408,6 +408,10 @@ SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm256_cmpgt_epi64(
 SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm256_blendv_epi8(b, a, m); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
+SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
+{
+    return u_sub(_mm256_castpd_si256(x), _mm256_castpd_si256(v_splat(0x1.8p52)));
+}
 
 /* Below 2^52 through the mantissa of 2^52, both ways (garbage elsewhere, as load_codes). */
 SP_INLINE SIMD_FN vec v_from_u(uvec a)

@@ -317,6 +317,10 @@ SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
 SP_INLINE SIMD_FN uvec u_sllv(uvec a, uvec count) { return _mm512_sllv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
+SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
+{
+    return u_sub(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52)));
+}
 SP_INLINE SIMD_FN vec v_from_u(uvec a) { return _mm512_cvtepu64_pd(a); }
 SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a) { return _mm512_cvtepu64_pd(a); } /* rounded to nearest */
 SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
