@@ -217,10 +217,10 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
     vec deficit = v_splat(s);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_mul(w[i], scale);
-        q[i] = v_trunc(x);
-        remainder[i] = v_sub(x, q[i]);
-        deficit = v_sub(deficit, q[i]);
+        vec x = v_mul(w[i], scale), floor = v_trunc(x);
+        remainder[i] = v_sub(x, floor);
+        deficit = v_sub(deficit, floor);
+        if (i > 0) q[i] = floor; /* q[0], which neither the index nor the counts read, not even stored */
     }
     return deficit;
 }
@@ -370,9 +370,10 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants
         any |= missed[b] = quantize_block(w[b], k, s, scale[b], ordered[b], q);
         if (encode_fused(k)) store_block(q, k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     }
-    if (!encode_fused(k))
-        for (size_t b = 0; b < blocks; ++b)
-            store_block(w[b], k, n, codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
+    if (!encode_fused(k) && significant)
+        for (size_t b = 0; b < blocks; ++b) store_block(w[b], k, n, codes + b * BLOCK, significant + b * BLOCK);
+    else if (!encode_fused(k)) /* the loop without the counts' test and pointer in it */
+        for (size_t b = 0; b < blocks; ++b) store_block(w[b], k, n, codes + b * BLOCK, NULL);
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }
 
