@@ -145,10 +145,9 @@ SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
     return layout;
 }
 
-/* Component i of eight consecutive vertices of k weights, widened to double (exact). */
-#define LOAD_ORDERED 0 /* the driver's weights_ordered serves */
-SP_INLINE SIMD_FN unsigned load_weights_ordered(const float* w, vec* x) { (void)w, (void)x; return 0; } /* unused */
+#define LOAD_ORDERED 0 /* the driver's load_weights and weights_ordered serve */
 
+/* Component i of eight consecutive vertices of k weights, widened to double (exact). */
 SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layout* layout, vec* x)
 {
     __m512 lo = _mm512_loadu_ps(w), hi = _mm512_loadu_ps(w + 8 * k - 16);

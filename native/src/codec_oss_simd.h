@@ -26,7 +26,8 @@
  *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
  *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
  *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
- *   LOAD_ORDERED (1: load_weights_ordered(w, x), K = 4's load_weights and weights_ordered in one),
+ *   LOAD_ORDERED (1: the ISA has load_weights_ordered(w, x), K = 4's load_weights and
+ *   weights_ordered in one),
  *   store_codes (u64), store_biased_codes (integral lanes ROUNDING_MAGIC + code as u64 code),
  *   code_check, check_start(max_code), load_codes(codes, check) (each checked <= max_code),
  *   check_passed, store_counts (lane values as bytes), codes_valid (every code of a block
@@ -201,8 +202,11 @@ SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const si
                                       vec* scale)
 {
     unsigned ordered;
-    if (LOAD_ORDERED && k == 4) ordered = load_weights_ordered(weights, w);
-    else {
+#if LOAD_ORDERED
+    if (k == 4) ordered = load_weights_ordered(weights, w);
+    else
+#endif
+    {
         load_weights(weights, k, layout, w);
         ordered = weights_ordered(w, k);
     }
