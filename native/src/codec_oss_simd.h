@@ -180,14 +180,14 @@ SP_INLINE SIMD_FN unsigned weights_ordered(const vec* w, uint32_t k)
 }
 
 /*
- * A batch's weights stream in and its codes out faster than the core's prefetchers fetch them
- * (1M vertices, K = 4 AVX2 at 38-44 bits: ~3.3 ns a vertex, ~2.5 in the cache): each block of
- * the first stage asks for the lines of the block ENCODE_PREFETCH vertices ahead, weights and
- * codes, which took K = 4 AVX2 encode to ~2.5 ns, 1.35x (the codes' lines gain the most: their
- * stores no longer wait for each line to be read for ownership). The addresses are formed as
- * integers, as they may lie past the batch (a prefetch never faults).
+ * A batch's weights stream in and its codes out faster than the core's prefetchers fetch them:
+ * 1M vertices of K = 4 took AVX2 ~3.3-4 ns a vertex where the same code takes ~2.5 on data in
+ * the cache. So each block of the first stage asks for the lines of the block ENCODE_PREFETCH
+ * vertices ahead, weights and codes, the codes' lines gaining the most (their stores no longer
+ * wait for each line to be read for ownership): ~1.3x for AVX2 and AVX-512 alike on that batch.
+ * The addresses are formed as integers, as they may lie past the batch (a prefetch never faults).
  */
-#define ENCODE_PREFETCH 128 /* vertices: 64 and 256 ran alike */
+#define ENCODE_PREFETCH 128 /* vertices ahead: 64 and 256 ran up to ~10% slower (AVX2, AVX-512) */
 
 SP_INLINE SIMD_FN void prefetch_block(const float* weights, uint32_t k, const uint64_t* codes)
 {
