@@ -152,6 +152,33 @@ SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layou
     for (uint32_t i = 0; i < k; ++i) x[i] = _mm256_cvtps_pd(_mm_setr_ps(w[i], w[k + i], w[2 * k + i], w[3 * k + i]));
 }
 
+/*
+ * K = 4's load_weights and weights_ordered in fewer vector operations (the encode's first stage
+ * is bound by them, on the three vector ports): the 4x4 transpose in float lanes goes to memory
+ * and each component comes back widened by a load-and-convert, which runs on a load port and one
+ * vector port where the register form takes a shuffle port too and an extract before it; the
+ * sorted check runs on the float lanes (the same compares as on the doubles they widen to: -0,
+ * NaN alike), components 0 | 1 against 1 | 2 and 2 | 3 against 3 | 0, two compares for four.
+ */
+#define LOAD_ORDERED 1
+SP_INLINE SIMD_FN unsigned load_weights_ordered(const float* w, vec* x)
+{
+    __m256 v01 = _mm256_loadu_ps(w), v23 = _mm256_loadu_ps(w + 8);
+    __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7); /* as load_weights */
+    __m256 c01 = _mm256_permutevar8x32_ps(_mm256_unpacklo_ps(v01, v23), order);
+    __m256 c23 = _mm256_permutevar8x32_ps(_mm256_unpackhi_ps(v01, v23), order);
+    _Alignas(32) float soa[16];
+    _mm256_store_ps(soa, c01);
+    _mm256_store_ps(soa + 8, c23);
+    SP_FORGET(soa); /* else the compiler forwards the stores to register extracts */
+    SP_UNROLL
+    for (uint32_t i = 0; i < 4; ++i) x[i] = _mm256_cvtps_pd(_mm_load_ps(soa + 4 * i));
+    __m256 next = _mm256_permute2f128_ps(c01, c23, 0x21), last = _mm256_permute2f128_ps(c23, c23, 0x81); /* 1 | 2, 3 | 0 */
+    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(c01, next, _CMP_GE_OQ), _mm256_cmp_ps(c23, last, _CMP_GE_OQ));
+    unsigned bits = (unsigned)_mm256_movemask_ps(ok); /* vertex v: bit v (w0 >= w1, w2 >= w3), bit v + 4 (w1 >= w2, w3 >= 0) */
+    return bits & (bits >> 4) & 15u;
+}
+
 /* Four vertices of k floats from k component vectors: transposes by shuffles and blends. */
 SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, float* out)
 {
@@ -297,6 +324,13 @@ SP_INLINE SIMD_FN void store_codes(uint64_t* codes, vec x)
                         _mm256_xor_si256(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic)));
 }
 
+/* Lanes ROUNDING_MAGIC + code (codec_oss_simd.h: 1.5 2^52 plus an integer of magnitude below
+ * 2^51) as the u64 codes: the difference of the bits. */
+SP_INLINE SIMD_FN void store_biased_codes(uint64_t* codes, vec x)
+{
+    _mm256_storeu_si256((__m256i*)codes, _mm256_sub_epi64(_mm256_castpd_si256(x), _mm256_castpd_si256(v_splat(0x1.8p52))));
+}
+
 /* Small integral lanes as four bytes. */
 SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
 {
@@ -374,6 +408,10 @@ SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm256_cmpgt_epi64(
 SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm256_blendv_epi8(b, a, m); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
+SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
+{
+    return u_sub(_mm256_castpd_si256(x), _mm256_castpd_si256(v_splat(0x1.8p52)));
+}
 
 /* Below 2^52 through the mantissa of 2^52, both ways (garbage elsewhere, as load_codes). */
 SP_INLINE SIMD_FN vec v_from_u(uvec a)

@@ -145,6 +145,8 @@ SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
     return layout;
 }
 
+#define LOAD_ORDERED 0 /* the driver's load_weights and weights_ordered serve */
+
 /* Component i of eight consecutive vertices of k weights, widened to double (exact). */
 SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layout* layout, vec* x)
 {
@@ -243,6 +245,13 @@ SP_INLINE SIMD_FN void store_codes(uint64_t* codes, vec x)
     _mm512_storeu_si512(codes, _mm512_cvttpd_epu64(x));
 }
 
+/* Lanes ROUNDING_MAGIC + code (codec_oss_simd.h: 1.5 2^52 plus an integer of magnitude below
+ * 2^51) as the u64 codes: the difference of the bits. */
+SP_INLINE SIMD_FN void store_biased_codes(uint64_t* codes, vec x)
+{
+    _mm512_storeu_si512(codes, _mm512_sub_epi64(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52))));
+}
+
 SP_INLINE SIMD_FN void store_counts(vec count, uint8_t* out)
 {
     _mm_storel_epi64((__m128i*)out, _mm512_cvtepi64_epi8(_mm512_cvttpd_epi64(count)));
@@ -307,6 +316,10 @@ SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
 SP_INLINE SIMD_FN uvec u_sllv(uvec a, uvec count) { return _mm512_sllv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
+SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
+{
+    return u_sub(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52)));
+}
 SP_INLINE SIMD_FN vec v_from_u(uvec a) { return _mm512_cvtepu64_pd(a); }
 SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a) { return _mm512_cvtepu64_pd(a); } /* rounded to nearest */
 SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)

@@ -26,7 +26,8 @@
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
  *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
  *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_lt_signed (signed compare),
- *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits)
+ *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits), u_unbias (integral lanes
+ *   ROUNDING_MAGIC + m as m, |m| < 2^51)
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
  *   in [0, 2^52))
@@ -137,31 +138,31 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec
 /* K = 4: the layer base u(k) = floor(a / 9), a = c k + 2 with c = (4k - 6N - 9) k + 3N^2 + 9N + 6
  * (layer_base's Horner form), for encode, split as u(k) = floor(c / 9) k + floor((r k + 2) / 9)
  * with r = c mod 9: c (below 2^46 at 64-bit codes, and positive for k <= (N + 1) / 2) and its
- * quotient are exact doubles, the quotient's floor exact as in layer_base (c/9 + 1/18 lies at
- * least 1/18 from an integer), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
+ * quotient are exact doubles, the quotient's floor codec_oss_simd.h's biased_ninth (of c - 4,
+ * the 4 taken off the constant), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
  * 2^64 as the sum is below 2^64) needs the integer lanes: one product where wide_layer_base
- * takes three and a table. Returns floor(c / 9) k; *small = floor((r k + 2) / 9). */
+ * takes three and a table. Returns floor(c / 9) k; *small = ROUNDING_MAGIC + floor((r k + 2) / 9). */
 SP_INLINE SIMD_FN uvec wide_layer_split(const wide_codec* c, vec k, vec* small)
 {
     vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
-    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
-    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
-    vec rest = v_fnmadd(ninth, v_splat(9.0), inner);
-    *small = v_floor(v_mul(v_fmadd(rest, k, v_splat(2.5)), v_splat(1.0 / 9.0)));
-    return u_mul_u32(u_from_v(ninth), u_from_v(k));
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 2)); /* c - 4 */
+    vec biased = biased_ninth(inner), ninth = v_sub(biased, v_splat(ROUNDING_MAGIC));
+    vec rest = v_add(v_fnmadd(ninth, v_splat(9.0), inner), v_splat(4.0));
+    *small = biased_ninth(v_fmsub(rest, k, v_splat(2.0)));
+    return u_mul_u32(u_unbias(biased), u_from_v(k));
 }
 
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
- * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: the double form of codec_oss_simd.h,
- * which also adds the layer base's small part (wide_layer_split). */
+ * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: codec_oss_simd.h's biased_row, which
+ * also adds the layer base's small part (wide_layer_split). */
 SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
     if (k == 2) return u_from_v(q[1]);
     if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
-    vec bottom = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n)), small;
+    vec half_apex = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n + 0.5)), small;
     uvec layer = wide_layer_split(c, q[3], &small);
-    vec in_layer = v_add(v_add(row_base(bottom, v_sub(q[2], q[3])), v_sub(q[1], q[2])), small);
-    return u_add(layer, u_from_v(in_layer));
+    vec in_layer = biased_row(half_apex, v_sub(q[2], q[3]), v_add(small, v_sub(q[1], q[2])));
+    return u_add(layer, u_unbias(in_layer));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
@@ -188,9 +189,8 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
-        load_weights(weights + b * BLOCK * k, k, layout, w[b]);
-        scale[b] = quantize_scale(w[b], k, c->scale);
-        ordered[b] = weights_ordered(w[b], k);
+        prefetch_block(weights + b * BLOCK * k, k, codes + b * BLOCK);
+        ordered[b] = load_block(weights + b * BLOCK * k, k, layout, c->scale, w[b], &scale[b]);
     }
     if (encode_fused(k))
         for (size_t b = 0; b < blocks; ++b)

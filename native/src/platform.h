@@ -24,10 +24,17 @@
 #define SP_X86_SIMD 1
 #define SP_TARGET(isa) __attribute__((target(isa)))
 #define SP_UNROLL _Pragma("GCC unroll 4")
+/* The compiler forgets what the object x holds, so its stores happen and later reads load it
+ * (a vector path that means to go through memory, where the compiler would forward in registers). */
+#define SP_FORGET(x) __asm__("" : "+m"(x))
+/* A hint to bring the cache line at address p into the caches (never faults, whatever p is). */
+#define SP_PREFETCH(p) __builtin_prefetch(p)
 #else
 #define SP_X86_SIMD 0
 #define SP_TARGET(isa)
 #define SP_UNROLL
+#define SP_FORGET(x) ((void)0)
+#define SP_PREFETCH(p) ((void)0)
 #endif
 
 /* From here to the end of the file, every product and sum rounds on its own: the vector paths

@@ -80,6 +80,15 @@ static void random_tuples(void)
     free(w), free(codes);
 }
 
+/* The grid points of `count` codes (scalar decode into w, count * K floats) encoded: at layer
+ * and row starts the encode's floors (rounding FMAs, codec_oss_simd.h's pack_block) are nearest
+ * integers of values 1/4 (odd rows) and 1/18 (layer bases) from a half-integer. */
+static int compare_encode_decoded(const sp_codec* c, const uint64_t* codes, size_t count, float* w, const char* what)
+{
+    CHECK(sp_decode_weights_batch_isa(c, codes, count, w, NULL, SP_ISA_SCALAR) == SP_OK);
+    return compare_encode(c, w, count, what);
+}
+
 /* N at and just past the largest the vector paths accept (exact there, scalar beyond), and the
  * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024, and K = 4 with the rows in
  * 32-bit lanes: 80264; double lanes beyond), and
@@ -110,6 +119,7 @@ static void range_edges(void)
                 codes[v] = code;
             }
             if (compare_decode(&c, codes, count, "edge decode")) return;
+            if (compare_encode_decoded(&c, codes, count, w, "edge grid encode")) return;
         }
     free(w), free(codes);
 }
@@ -136,7 +146,9 @@ static void estimate_boundaries(void)
                 if (start + d >= 2 && start + d - 2 <= c.max_code) codes[count++] = start + d - 2;
         }
         compare_decode(&c, codes, count, "boundary decode");
-        free(codes);
+        float* w = malloc(count * k * sizeof(float) + 1);
+        compare_encode_decoded(&c, codes, count, w, "boundary encode"); /* every layer base's residue mod 9 */
+        free(codes), free(w);
     }
 }
 
@@ -161,6 +173,10 @@ static void split_row_boundaries(void)
                     if (start + d >= 2 && start + d - 2 <= c.max_code) codes[count++] = start + d - 2;
             }
             if (compare_decode(&c, codes, count, "split row boundary decode")) break;
+            float* w = malloc(count * 4 * sizeof(float) + 1);
+            int failed = compare_encode_decoded(&c, codes, count, w, "row boundary encode"); /* rows of both parities */
+            free(w);
+            if (failed) break;
         }
         free(codes);
     }
@@ -211,6 +227,38 @@ static void odd_weights(void)
         compare_encode(&c, w, count, "odd encode");
     }
     free(w);
+}
+
+/* One lane of a batch of sorted tuples made unsorted (each neighbouring pair swapped, a negative
+ * or NaN weight at each place) or kept sorted by a zero or -0 last weight, in each lane of the
+ * first three AVX-512 / six AVX2 blocks: each lane's order check alone (for K = 4 on AVX2 in float
+ * lanes, two compares covering two pairs each) decides whether the lane is redone. */
+static void unsorted_lanes(void)
+{
+    enum { COUNT = 26 };
+    static const uint32_t budgets[] = {16, 38, 52};
+    float w[COUNT * 4];
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+            sp_codec c;
+            CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, budgets[b], &c) == SP_OK);
+            for (size_t lane = 0; lane < 24; ++lane)
+                for (uint32_t change = 0; change < 2 * k + 2; ++change) {
+                    for (size_t v = 0; v < COUNT; ++v) /* distinct weights: 4/10, 3/10, 2/10, 1/10 for K = 4 */
+                        for (uint32_t i = 0; i < k; ++i) w[v * k + i] = (float)(k - i) / (float)(k * (k + 1) / 2);
+                    float* x = w + lane * k;
+                    if (change < k - 1) { /* places change and change + 1 swapped */
+                        float t = x[change];
+                        x[change] = x[change + 1], x[change + 1] = t;
+                    } else if (change < 2 * k - 1) {
+                        x[change - (k - 1)] = NAN;
+                    } else {
+                        const float last[] = {-1e-3f, -0.0f, 0.0f};
+                        x[k - 1] = last[change - (2 * k - 1)];
+                    }
+                    if (compare_encode(&c, w, COUNT, "unsorted lane encode")) return;
+                }
+        }
 }
 
 /* Counts around the block size and pointers off 16/32-byte alignment. */
@@ -320,6 +368,7 @@ int main(void)
         counts_and_alignment();
         invalid_codes();
         odd_weights();
+        unsorted_lanes();
         range_edges();
         estimate_boundaries();
         split_row_boundaries();
