@@ -415,7 +415,7 @@ SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_la
     _mm_storeu_ps(out + 4, _mm_unpackhi_ps(first, second));
 }
 
-/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_block):
+/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_start):
  * the two weights of four vertices as two component vectors (exact), by one permute of the eight
  * floats (store_pairs backwards); the other primitives it needs. */
 SP_INLINE SIMD_FN void load_pairs(const float* w, vec* first, vec* second)

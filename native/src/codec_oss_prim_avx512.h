@@ -313,7 +313,7 @@ SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
 }
 SP_INLINE SIMD_FN uvec u_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
 
-/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_block):
+/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_start):
  * the two weights of eight vertices as two component vectors (exact), by one permute of the 16
  * floats; the other primitives it needs. */
 SP_INLINE SIMD_FN void load_pairs(const float* w, vec* first, vec* second)

@@ -1,9 +1,9 @@
 /*
  * The OSS batch paths for codes past the double lanes' exact range (internal): K = 3 past
  * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 past N = 2^48 (every width up to 64 bits; K = 2 encode
- * past N = 2^49 in sp_grid_round_pair's exact rounding, with FMA residuals). The driver is codec_oss_wide_simd.h,
- * the per-ISA files codec_oss_batch_avx2.c and codec_oss_batch_avx512.c; codec_oss_batch.c
- * dispatches.
+ * past N = 2^49 in sp_grid_round_pair's exact rounding, with FMA residuals). The driver is
+ * codec_oss_wide_simd.h, the per-ISA files codec_oss_batch_avx2.c and codec_oss_batch_avx512.c;
+ * codec_oss_batch.c dispatches.
  */
 #ifndef SKINPACK_CODEC_OSS_WIDE_H
 #define SKINPACK_CODEC_OSS_WIDE_H

@@ -240,7 +240,7 @@ static size_t near_tie_pairs(uint64_t s, float* weights)
     return count;
 }
 
-/* Pairs the vector lanes' FMA rounding (codec_oss_wide_simd.h's wide_pair_block) takes at any
+/* Pairs the vector lanes' FMA rounding (codec_oss_wide_simd.h's wide_pair_start) takes at any
  * gap where d = w0 + w1 is exact in double: the smaller weight with 1..24 significant bits, so
  * that x1 = s w1 / d lies on or next to targets at the lanes' cut-offs (no f below y = 2^13,
  * f = round(y / 2^12) 2^12 above it, whose first steps 2^12, 3 2^11 lie around there) and at
