@@ -3,7 +3,8 @@
  * double-lane paths (codec_oss_simd.h) are exact where every OSS intermediate stays below 2^50;
  * past that the wide paths (codec_oss_wide_simd.h) run the layer and row bases in 64-bit integer
  * lanes, up to 64-bit codes. Both per ISA in codec_oss_batch_avx512.c and codec_oss_batch_avx2.c.
- * K = 2 encode past N = 2^49 runs sp_grid_round_pair's exact integer rounding in the wide lanes.
+ * K = 2 encode past N = 2^49 runs sp_grid_round_pair's exact rounding in the wide driver's
+ * double lanes (FMA residuals for its 128-bit products).
  */
 #include "codec_internal.h"
 #include "codec_oss_wide.h"
@@ -42,11 +43,8 @@ static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
 
 int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest)
 {
-    oss_lanes lanes = oss_lanes_for(codec);
-    sp_isa isa = batch_isa(lanes, widest);
-    if (encode && lanes == LANES_WIDE && codec->influences == 2 && codec->scale >= SP_GRID_DOUBLE_LIMIT)
-        return isa >= SP_OSS_WIDE_PAIR_ISA;
-    return isa > SP_ISA_SCALAR;
+    (void)encode; /* each ISA takes both ways, K = 2 encode past 2^50 grids too (codec_oss_wide_simd.h) */
+    return batch_isa(oss_lanes_for(codec), widest) > SP_ISA_SCALAR;
 }
 
 /* AVX-512 takes blocks of 8, AVX2 what is left in blocks of 4 (the tail, or the rest after a

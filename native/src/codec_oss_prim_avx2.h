@@ -16,8 +16,6 @@
 SP_FP_CONTRACT_OFF
 #define SIMD_FN SP_TARGET("avx2,fma")
 #define SIMD_NAME(name) sp_oss_##name##_avx2
-#define SIMD_ISA 1 /* SP_ISA_AVX2, for the preprocessor */
-_Static_assert(SIMD_ISA == SP_ISA_AVX2, "SIMD_ISA is this file's sp_isa");
 #define BLOCK 4
 #define ENCODE_CHUNK 16 /* K = 3 encode ~3% faster than 8 */
 #define ENCODE_FUSED 0 /* in one stage K = 4 encode spills and runs ~25% slower (encode_fused) */
@@ -454,6 +452,24 @@ SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_la
     _mm_storeu_ps(out, _mm_unpacklo_ps(first, second));
     _mm_storeu_ps(out + 4, _mm_unpackhi_ps(first, second));
 }
+
+/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_start):
+ * the two weights of four vertices as two component vectors (exact), by one permute of the eight
+ * floats (store_pairs backwards); the other primitives it needs. */
+SP_INLINE SIMD_FN void load_pairs(const float* w, vec* first, vec* second)
+{
+    __m256 split = _mm256_permutevar8x32_ps(_mm256_loadu_ps(w), _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+    *first = _mm256_cvtps_pd(_mm256_castps256_ps128(split));
+    *second = _mm256_cvtps_pd(_mm256_extractf128_ps(split, 1));
+}
+SP_INLINE SIMD_FN mask m_eq(vec a, vec b) { return _mm256_cmp_pd(a, b, _CMP_EQ_OQ); }
+SP_INLINE SIMD_FN vec v_keep_where(vec x, mask m) { return _mm256_and_pd(x, m); } /* m ? x : +0 */
+/* The double just below x > 0 where m (x elsewhere): its bits less one, by adding the -1 lanes. */
+SP_INLINE SIMD_FN vec v_below_where(vec x, mask m)
+{
+    return _mm256_castsi256_pd(_mm256_add_epi64(_mm256_castpd_si256(x), _mm256_castpd_si256(m)));
+}
+SP_INLINE SIMD_FN uvec u_bits(vec x) { return _mm256_castpd_si256(x); } /* the bits, as they are */
 
 /* K = 3 weights likewise, as four vertices: components 0, 1 through one permute, 2 through
  * another, blended; then the last vertex and a half the same way. */

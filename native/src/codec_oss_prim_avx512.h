@@ -15,8 +15,6 @@
 SP_FP_CONTRACT_OFF /* avx512f implies fma */
 #define SIMD_FN SP_TARGET("avx512f,avx512dq,avx512vl")
 #define SIMD_NAME(name) sp_oss_##name##_avx512
-#define SIMD_ISA 2 /* SP_ISA_AVX512, for the preprocessor */
-_Static_assert(SIMD_ISA == SP_ISA_AVX512, "SIMD_ISA is this file's sp_isa");
 #define BLOCK 8
 #define ENCODE_CHUNK 16 /* blocks per stage: on Zen 5, 8 is ~3% slower for K = 3, 4, 32 no faster */
 #define DECODE_CHUNK 16 /* on Zen 5, 8 is ~5% slower for K = 3, 4 decode (4 was ~20% slower on Zen 4) */
@@ -313,7 +311,6 @@ SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_mul(a, b); }
 SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b) { return _mm512_cmplt_epu64_mask(a, b); }
 SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm512_cmplt_epi64_mask(a, b); }
 SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
-SP_INLINE SIMD_FN uvec u_sllv(uvec a, uvec count) { return _mm512_sllv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
 SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
 SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
@@ -328,9 +325,26 @@ SP_INLINE SIMD_FN void v_halves(uvec a, vec* high, vec* low)
     *low = _mm512_cvtepu64_pd(u_and(a, u_splat(0xFFFFFFFFu)));
 }
 SP_INLINE SIMD_FN uvec u_from_v(vec x) { return _mm512_cvttpd_epu64(x); }
-SP_INLINE SIMD_FN vec v_from_i_rounded(uvec a) { return _mm512_cvtepi64_pd(a); } /* rounded to nearest */
-SP_INLINE SIMD_FN uvec u_from_v_truncated(vec x) { return _mm512_cvttpd_epu64(x); }
-SP_INLINE SIMD_FN uvec i_from_v_small(vec x) { return _mm512_cvttpd_epi64(x); }
+
+/* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_start):
+ * the two weights of eight vertices as two component vectors (exact), by one permute of the 16
+ * floats; the other primitives it needs. */
+SP_INLINE SIMD_FN void load_pairs(const float* w, vec* first, vec* second)
+{
+    __m512 split = _mm512_permutexvar_ps(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15),
+                                         _mm512_loadu_ps(w));
+    *first = _mm512_cvtps_pd(_mm512_castps512_ps256(split));
+    *second = _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(split), 1)));
+}
+SP_INLINE SIMD_FN mask m_eq(vec a, vec b) { return _mm512_cmp_pd_mask(a, b, _CMP_EQ_OQ); }
+SP_INLINE SIMD_FN vec v_keep_where(vec x, mask m) { return _mm512_maskz_mov_pd(m, x); } /* m ? x : +0 */
+/* The double just below x > 0 where m (x elsewhere): its bits less one. */
+SP_INLINE SIMD_FN vec v_below_where(vec x, mask m)
+{
+    __m512i bits = _mm512_castpd_si512(x);
+    return _mm512_castsi512_pd(_mm512_mask_sub_epi64(bits, m, bits, _mm512_set1_epi64(1)));
+}
+SP_INLINE SIMD_FN uvec u_bits(vec x) { return _mm512_castpd_si512(x); } /* the bits, as they are */
 
 /* K = 2 and 3 weights: codec_oss_simd.h's store (two-source permutes) serves. */
 SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)

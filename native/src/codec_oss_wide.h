@@ -1,21 +1,14 @@
 /*
  * The OSS batch paths for codes past the double lanes' exact range (internal): K = 3 past
  * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 past N = 2^48 (every width up to 64 bits; K = 2 encode
- * past N = 2^49 in sp_grid_round_pair's exact integer form). The driver is codec_oss_wide_simd.h,
- * the per-ISA files codec_oss_batch_avx2.c and codec_oss_batch_avx512.c; codec_oss_batch.c
- * dispatches.
+ * past N = 2^49 in sp_grid_round_pair's exact rounding, with FMA residuals). The driver is
+ * codec_oss_wide_simd.h, the per-ISA files codec_oss_batch_avx2.c and codec_oss_batch_avx512.c;
+ * codec_oss_batch.c dispatches.
  */
 #ifndef SKINPACK_CODEC_OSS_WIDE_H
 #define SKINPACK_CODEC_OSS_WIDE_H
 
 #include "codec_internal.h"
-
-/* The narrowest ISA whose wide lanes take K = 2 encode on grids past 2^50, as a number for the
- * preprocessor (the sp_isa value; the drivers compare it with their SIMD_ISA): AVX-512's lanes
- * ran 1.9 ns a vertex, AVX2's four 7.3, slower than the scalar code's 128/64 division (5.4). */
-#define SP_OSS_WIDE_PAIR_ISA_VALUE 2
-#define SP_OSS_WIDE_PAIR_ISA ((sp_isa)SP_OSS_WIDE_PAIR_ISA_VALUE)
-_Static_assert(SP_OSS_WIDE_PAIR_ISA == SP_ISA_AVX512, "SP_OSS_WIDE_PAIR_ISA_VALUE is AVX-512's sp_isa");
 
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole
  * blocks only (8 lanes for AVX-512, 4 for AVX2), bit-identical to sp_oss_encode_one and

@@ -198,6 +198,30 @@ static size_t tie_pairs(uint64_t s, float* weights)
     return count;
 }
 
+/* Exact ties whose sum is not a power of two (tie_pairs' are; there the tie is x = s/4 or s/2
+ * for most grids, the same side of every quotient): a = A 2^e, d = q 2^(e + t + 1) for odd q
+ * and s = s' 2^t with s' odd, so that x = s a / d = s' (A / q) 2^-1 is an odd multiple of 1/2
+ * where q divides s' (any odd A < q 2^t) or A (A = q A', A' odd < 2^t); the two weights in
+ * either slot order, so that some ties go up and some down, on either side of the lanes'
+ * estimate. */
+static size_t odd_tie_pairs(uint64_t s, float* weights)
+{
+    uint32_t twos = 0;
+    while (!((s >> twos) & 1)) ++twos;
+    size_t count = 0;
+    for (uint64_t q = 3; q < 0x400000 && count < 1000; q += 2)
+        for (int t = 0, divides = (s >> twos) % q == 0; t < (divides ? 64 : q < 4096 ? 4 : 0); ++t) {
+            uint64_t sum = q << (twos + 1), half = sum / 2, a = q * (2 * (rng_next() % ((half / q + 1) / 2)) + 1);
+            if (divides) a = 2 * (rng_next() % (half / 2)) + 1;
+            if (sum >= 0x1000000 || a >= half) continue;
+            int exponent = -10 - (int)(rng_next() % 50), swap = (int)(rng_next() % 2);
+            weights[count * 2 + swap] = ldexpf((float)a, exponent);
+            weights[count * 2 + 1 - swap] = ldexpf((float)(sum - a), exponent);
+            ++count;
+        }
+    return count;
+}
+
 /* Near ties at gaps 25..60: for w0 = a 2^g (units of w1's last bit), b random, a picked so that
  * x1 = s b / (a 2^g + b) is near m + 1/2 (within x 2^-25, where that is below 1). */
 static size_t near_tie_pairs(uint64_t s, float* weights)
@@ -211,6 +235,39 @@ static size_t near_tie_pairs(uint64_t s, float* weights)
             if (better < 0x800000 || better > 0xFFFFFF) continue;
             weights[count * 2] = (float)ldexpl(better, (int)g - 30);
             weights[count * 2 + 1] = (float)ldexpl(b, -30);
+            ++count;
+        }
+    return count;
+}
+
+/* Pairs the vector lanes' FMA rounding (codec_oss_wide_simd.h's wide_pair_start) takes at any
+ * gap where d = w0 + w1 is exact in double: the smaller weight with 1..24 significant bits, so
+ * that x1 = s w1 / d lies on or next to targets at the lanes' cut-offs (no f below y = 2^13,
+ * f = round(y / 2^12) 2^12 above it, whose first steps 2^12, 3 2^11 lie around there) and at
+ * larger quotients, and the gaps 26..32 around d's exactness with full significands. */
+static size_t sparse_pairs(uint64_t s, float* weights)
+{
+    static const double targets[] = {0x1p11, 0x1p11 + 1, 0x1.8p11, 0x1p12, 0x1.4p12, 0x1.8p12, 0x1p13 - 2, 0x1p13 - 1,
+                                     0x1p13 - 0.5, 0x1p13, 0x1p13 + 0.5, 0x1p13 + 1, 0x1p13 + 2, 0x1.4p13, 0x1p14,
+                                     0x1p14 + 1, 0x1p15, 0x1p20 + 0.5, 0x1p30, 0x1p40 + 0.5, 0x1p50};
+    static const int precisions[] = {1, 2, 3, 4, 6, 8, 16, 24};
+    size_t count = 0;
+    for (size_t t = 0; t < sizeof(targets) / sizeof(targets[0]) && targets[t] < (double)s / 4; ++t)
+        for (size_t p = 0; p < sizeof(precisions) / sizeof(precisions[0]); ++p)
+            for (int step = -1; step <= 1; ++step) {
+                long double large = ldexpl((long double)((rng_next() & 0x7FFFFF) | 0x800000), -24 - (int)(rng_next() % 20));
+                long double small = (long double)targets[t] * large / ((long double)s - targets[t]);
+                int exponent = ilogbl(small) - precisions[p] + 1; /* small's last bit */
+                long double significand = roundl(ldexpl(small, -exponent)) + step;
+                weights[count * 2] = (float)large;
+                weights[count * 2 + 1] = (float)ldexpl(significand, exponent);
+                ++count;
+            }
+    for (int gap = 26; gap <= 32; ++gap)
+        for (int t = 0; t < 8; ++t) {
+            uint64_t significand = t < 2 ? 0xFFFFFF : (rng_next() & 0x7FFFFF) | 0x800000;
+            weights[count * 2] = make_float(rng_next() & 0x7FFFFF, -24);
+            weights[count * 2 + 1] = make_float(significand, -24 - gap);
             ++count;
         }
     return count;
@@ -284,6 +341,10 @@ int main(void)
         size_t near = near_tie_pairs(codec.scale, weights);
         CHECK(near > 20);
         check_codec(&codec, weights, near, "near ties");
+        check_codec(&codec, weights, sparse_pairs(codec.scale, weights), "sparse");
+        size_t odd_ties = odd_tie_pairs(codec.scale, weights);
+        CHECK(odd_ties > 100 || codec.scale % ((uint64_t)1 << 22) == 0); /* s = 2^50: no ties of floats */
+        check_codec(&codec, weights, odd_ties, "odd ties");
     }
     free(weights);
     return check_report("test_oss_exact");
