@@ -77,8 +77,8 @@ typedef struct skin_state {
     sp_meshlet_plan plan;       /* the meshlets closed so far, written at the end */
     float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
     int regular;                /* growth ranks ties by rings and prefers the meshlet's joints and band (is_regular) */
-    uint8_t* influences;        /* vertex_count: used influences of each vertex */
-    uint32_t open_band;         /* most used influences of an open meshlet's vertex: its palette's floor */
+    uint8_t* influences;        /* vertex_count: used influences of each vertex (regular meshes only) */
+    uint32_t open_band;         /* regular: most used influences of an open meshlet's vertex, its palette's floor */
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
 
@@ -246,11 +246,10 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
         }
     }
     sp_meshlet_add(ctx, t);
-    for (uint32_t i = first_new; i < ctx->open_vertex_count; ++i) {
+    for (uint32_t i = first_new; s->regular && i < ctx->open_vertex_count; ++i) {
         uint32_t used = s->influences[ctx->open_vertices[i]];
         s->open_band = used > s->open_band ? used : s->open_band;
-        if (s->regular)
-            s->ring[i] = (uint16_t)(ring == UINT16_MAX ? 0 : ring + 1);
+        s->ring[i] = (uint16_t)(ring == UINT16_MAX ? 0 : ring + 1);
     }
     for (int i = 0; i < 3; ++i)
         s->centroid_sum[i] += s->centroid[(size_t)t * 3 + i];
@@ -563,11 +562,12 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
     s.influences = sp_meshlet_carve(&cursor, v_count);
     s.open_band = 0;
-    count_influences(ctx, &s);
     sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     s.regular = is_regular(ctx, &s);
+    if (s.regular)
+        count_influences(ctx, &s);
     build_spatial_order(ctx, &s);
     size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
 
