@@ -81,6 +81,7 @@ typedef struct skin_state {
     int regular;                /* growth ranks ties by rings and prefers the meshlet's joints and band (is_regular) */
     uint8_t* influences;        /* vertex_count: used influences of each vertex (regular meshes only) */
     uint32_t open_band;         /* regular: most used influences of an open meshlet's vertex, its palette's floor */
+    uint32_t open_border;       /* open meshlet vertices that still have free triangles */
     int banded;                 /* regular and its influence bands wide (count_influences): the band cost applies */
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
@@ -279,6 +280,12 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
                 list[s->live[v]] = t;
                 break;
             }
+        /* the border: a vertex that was in the meshlet leaves it with its last free triangle,
+         * a new one joins it while it has free triangles */
+        if (ctx->vertex_slot[v] < first_new)
+            s->open_border -= s->live[v] == 0;
+        else
+            s->open_border += s->live[v] > 0;
     }
 }
 
@@ -380,6 +387,7 @@ static void flush(sp_meshlet_context* ctx, skin_state* s)
     s->open_stamp++;
     s->open_tuple_count = 0;
     s->open_band = 0;
+    s->open_border = 0;
 }
 
 /* Tuples triangle t would add to the open meshlet's local LUT. */
@@ -444,10 +452,7 @@ static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_
  * a regular mesh can afford to prefer its joints and its band (best_neighbour). */
 static int compact_meshlet(const sp_meshlet_context* ctx, const skin_state* s)
 {
-    uint32_t border = 0;
-    for (uint32_t i = 0; i < ctx->open_vertex_count; ++i)
-        border += s->live[ctx->open_vertices[i]] > 0;
-    return (float)border <= COMPACT_BORDER * sqrtf(12.0f * (float)ctx->open_vertex_count);
+    return (float)s->open_border <= COMPACT_BORDER * sqrtf(12.0f * (float)ctx->open_vertex_count);
 }
 
 /* Whether every corner of tri has fewer used influences than the open meshlet's most: the
@@ -575,6 +580,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
     s.influences = sp_meshlet_carve(&cursor, v_count);
     s.open_band = 0;
+    s.open_border = 0;
     sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
