@@ -81,7 +81,7 @@ typedef struct skin_state {
     int regular;                /* growth ranks ties by rings and prefers the meshlet's joints and band (is_regular) */
     uint8_t* influences;        /* vertex_count: used influences of each vertex (regular meshes only) */
     uint32_t open_band;         /* regular: most used influences of an open meshlet's vertex, its palette's floor */
-    uint32_t open_border;       /* open meshlet vertices that still have free triangles */
+    uint32_t open_border;       /* regular: open meshlet vertices that still have free triangles */
     int banded;                 /* regular and its influence bands wide (count_influences): the band cost applies */
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
@@ -280,11 +280,11 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
                 list[s->live[v]] = t;
                 break;
             }
-        /* the border: a vertex that was in the meshlet leaves it with its last free triangle,
-         * a new one joins it while it has free triangles */
-        if (ctx->vertex_slot[v] < first_new)
+        /* regular: the border; a vertex that was in the meshlet leaves it with its last free
+         * triangle, a new one joins it while it has free triangles */
+        if (s->regular && ctx->vertex_slot[v] < first_new)
             s->open_border -= s->live[v] == 0;
-        else
+        else if (s->regular)
             s->open_border += s->live[v] > 0;
     }
 }
