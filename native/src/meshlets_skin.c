@@ -18,7 +18,14 @@
  * keeps the meshlets compact and still steers growth along the palette; on a regular
  * triangulation (is_regular: a subdivision surface) first to the fewest new joints, then to the
  * innermost hop ring from the meshlet's first vertices, which keeps them compact in the
- * topology that the vertex limit counts, whatever the triangles' shape. When no adjacent
+ * topology that the vertex limit counts, whatever the triangles' shape. There, while the open
+ * meshlet is compact (compact_meshlet: a short border), a new joint also costs
+ * REGULAR_JOINT_COST and, where the influence bands are wide (count_influences), a triangle
+ * below the meshlet's band (all its corners with fewer influences than the meshlet's most)
+ * REGULAR_BAND_COST: a subdivision surface's weights form wide bands of equal influence counts,
+ * and a meshlet that keeps to its band leaves the lower band's triangles to meshlets with
+ * smaller palettes; once the border grows long the meshlet grows for compactness alone, which
+ * keeps the count. When no adjacent
  * triangle fits, the meshlet closes, leaves seed candidates on its border, and the next meshlet
  * starts at the least enclosed seed (fewest free triangles around its corners, then nearest the
  * mesh's low corner), so meshlets sweep across the surface and leave no slivers behind. When
@@ -32,6 +39,7 @@
 #include "meshlets_internal.h"
 
 #include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,6 +54,10 @@
 #define SEED_POOL 256             /* seed candidates kept at most */
 #define REGULAR_VALENCE 6         /* triangles around an interior vertex of a regular triangulation */
 #define REGULAR_SHARE 0.9         /* the share of such vertices from which a mesh counts as regular */
+#define REGULAR_JOINT_COST 3.0f   /* regular mesh, compact meshlet: a new joint costs as much as 3 new vertices, */
+#define REGULAR_BAND_COST 0.5f    /* a corner set below the meshlet's band half a vertex (under one priority step) */
+#define COMPACT_BORDER 0.9f       /* compact: border vertices <= 0.9 x sqrt(12 x vertices), a hexagonal disc's */
+#define BANDED_SHARE 0.9          /* the band cost needs this share of triangles with equal influence counts */
 
 typedef struct skin_state {
     uint32_t* adjacency_offset; /* vertex_count + 1: start of each vertex's triangle list */
@@ -66,7 +78,11 @@ typedef struct skin_state {
     uint32_t seed_count;
     sp_meshlet_plan plan;       /* the meshlets closed so far, written at the end */
     float centroid_sum[3];      /* sum of the open meshlet's triangle centroids: its centre drives proximity */
-    int regular;                /* growth ranks ties by rings (is_regular) */
+    int regular;                /* growth ranks ties by rings and prefers the meshlet's joints and band (is_regular) */
+    uint8_t* influences;        /* vertex_count: used influences of each vertex (regular meshes only) */
+    uint32_t open_band;         /* regular: most used influences of an open meshlet's vertex, its palette's floor */
+    uint32_t open_border;       /* regular: open meshlet vertices that still have free triangles */
+    int banded;                 /* regular and its influence bands wide (count_influences): the band cost applies */
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
 
@@ -74,7 +90,8 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
 {
     size_t tuple_slots = sp_meshlet_tuple_set_slots(vertex_count);
     size_t per_vertex = sp_meshlet_align8((vertex_count + 1) * sizeof(uint32_t)) + /* adjacency_offset */
-                        2 * sp_meshlet_align8(vertex_count * sizeof(uint32_t));     /* live, vertex_tuple */
+                        2 * sp_meshlet_align8(vertex_count * sizeof(uint32_t)) +    /* live, vertex_tuple */
+                        sp_meshlet_align8(vertex_count);                            /* influences */
     size_t per_triangle = sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + /* adjacency */
                           sp_meshlet_align8(triangle_count) +                        /* emitted */
                           sp_meshlet_align8(triangle_count * 3 * sizeof(float)) +    /* centroid */
@@ -133,6 +150,28 @@ static int is_regular(const sp_meshlet_context* ctx, const skin_state* s)
         regular += s->live[v] == REGULAR_VALENCE;
     }
     return used > 0 && (double)regular >= REGULAR_SHARE * (double)used;
+}
+
+/* Used influences (weight > 0) of every vertex: a meshlet's palette holds at least the most of
+ * its vertices', which is the band the growth on a regular mesh keeps to. Sets banded when at
+ * least BANDED_SHARE of the triangles have equal counts at their three corners: the bands are
+ * wide (subdivided meshes: 94-99 %), so a meshlet can keep to one. Where they are a few rows
+ * wide every compact meshlet spans several, and keeping to one only makes it ragged (a grid
+ * striped every 2 rows: 10 % more meshlets and 2 % more entries with the band cost). */
+static void count_influences(const sp_meshlet_context* ctx, skin_state* s)
+{
+    for (size_t v = 0; v < ctx->vertex_count; ++v) {
+        uint8_t used = 0;
+        for (size_t k = 0; k < ctx->influences; ++k)
+            used += ctx->weights[v * ctx->influences + k] > 0.0f;
+        s->influences[v] = used;
+    }
+    size_t uniform = 0;
+    for (size_t t = 0; t < ctx->triangle_count; ++t) {
+        const uint32_t* tri = ctx->indices + t * 3;
+        uniform += s->influences[tri[0]] == s->influences[tri[1]] && s->influences[tri[1]] == s->influences[tri[2]];
+    }
+    s->banded = (double)uniform >= BANDED_SHARE * (double)ctx->triangle_count;
 }
 
 /* 10 bits per axis interleaved: z y x z y x ... */
@@ -221,8 +260,11 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
         }
     }
     sp_meshlet_add(ctx, t);
-    for (uint32_t i = first_new; s->regular && i < ctx->open_vertex_count; ++i)
+    for (uint32_t i = first_new; s->regular && i < ctx->open_vertex_count; ++i) {
+        uint32_t used = s->influences[ctx->open_vertices[i]];
+        s->open_band = used > s->open_band ? used : s->open_band;
         s->ring[i] = (uint16_t)(ring == UINT16_MAX ? 0 : ring + 1);
+    }
     for (int i = 0; i < 3; ++i)
         s->centroid_sum[i] += s->centroid[(size_t)t * 3 + i];
     s->emitted[t] = 1;
@@ -238,6 +280,12 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
                 list[s->live[v]] = t;
                 break;
             }
+        /* regular: the border; a vertex that was in the meshlet leaves it with its last free
+         * triangle, a new one joins it while it has free triangles */
+        if (s->regular && ctx->vertex_slot[v] < first_new)
+            s->open_border -= s->live[v] == 0;
+        else if (s->regular)
+            s->open_border += s->live[v] > 0;
     }
 }
 
@@ -338,6 +386,8 @@ static void flush(sp_meshlet_context* ctx, skin_state* s)
     s->centroid_sum[0] = s->centroid_sum[1] = s->centroid_sum[2] = 0.0f;
     s->open_stamp++;
     s->open_tuple_count = 0;
+    s->open_band = 0;
+    s->open_border = 0;
 }
 
 /* Tuples triangle t would add to the open meshlet's local LUT. */
@@ -395,6 +445,24 @@ static float topology_priority(const skin_state* s, const uint32_t* tri, uint32_
     return (float)new_vertices + ((a == 2) + (b == 2) + (c == 2) >= 2 ? 1.0f : 2.0f);
 }
 
+/* Whether the open meshlet is still a compact patch: at most COMPACT_BORDER x sqrt(12 n) of its
+ * n vertices have free triangles left (a hexagonal disc of a valence-6 triangulation with side k
+ * has 3k^2 + 3k + 1 vertices, 6k of them on its border). A meshlet of 64 vertices holds 2n - b - 2
+ * triangles with b border vertices, so a ragged one costs meshlets; while it is compact, growth on
+ * a regular mesh can afford to prefer its joints and its band (best_neighbour). */
+static int compact_meshlet(const sp_meshlet_context* ctx, const skin_state* s)
+{
+    return (float)s->open_border <= COMPACT_BORDER * sqrtf(12.0f * (float)ctx->open_vertex_count);
+}
+
+/* Whether every corner of tri has fewer used influences than the open meshlet's most: the
+ * triangle lies in a lower band, which a meshlet of its own would cover with a smaller palette. */
+static int below_band(const skin_state* s, const uint32_t* tri)
+{
+    return s->influences[tri[0]] < s->open_band && s->influences[tri[1]] < s->open_band &&
+           s->influences[tri[2]] < s->open_band;
+}
+
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
  * limit. The joint and tuple terms are never negative, so a candidate whose topology alone is
  * worse than the best so far is skipped before they are counted. */
@@ -405,8 +473,14 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
         return best;
     float point[3];
     open_centroid(ctx, s, point);
-    /* in the meshlet's last vertices a new joint also costs LATE_JOINT_COST (see the top) */
-    float joint_cost = ctx->options.joint_cost;
+    /* on a regular mesh, while the meshlet is compact, a new joint costs REGULAR_JOINT_COST and a
+     * triangle below its band REGULAR_BAND_COST (see the top); in the meshlet's last vertices a
+     * new joint also costs LATE_JOINT_COST */
+    float joint_cost = ctx->options.joint_cost, band_cost = 0.0f;
+    if (s->regular && compact_meshlet(ctx, s)) {
+        joint_cost += REGULAR_JOINT_COST;
+        band_cost = s->banded ? REGULAR_BAND_COST : 0.0f;
+    }
     if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
         joint_cost += LATE_JOINT_COST;
     for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
@@ -425,6 +499,8 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
             float cost = priority + joint_cost * (float)new_joints;
+            if (band_cost > 0.0f && new_vertices > 0 && below_band(s, tri))
+                cost += band_cost;
             if (ctx->options.tuple_cost > 0.0f)
                 cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
@@ -502,10 +578,16 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     s.open_tuple_count = 0;
     s.seed_count = 0;
     s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
+    s.influences = sp_meshlet_carve(&cursor, v_count);
+    s.open_band = 0;
+    s.open_border = 0;
     sp_meshlet_plan_init(&s.plan, &cursor, t_count);
     memset(s.emitted, 0, t_count);
     build_adjacency(ctx, &s);
     s.regular = is_regular(ctx, &s);
+    s.banded = 0;
+    if (s.regular)
+        count_influences(ctx, &s);
     build_spatial_order(ctx, &s);
     size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
 
