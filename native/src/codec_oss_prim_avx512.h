@@ -284,7 +284,8 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root yf)
 
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx512
 
-#define WIDE_ROOT_NEWTON 0 /* its root (a double Newton step) is good to far below half a layer */
+/* Its root (a double Newton step) is good to far below half a layer at the wide lanes' t. */
+SP_INLINE SIMD_FN vec root_finish_fine(vec x, root yf) { return root_finish(x, yf); }
 
 typedef __m512i uvec;
 typedef __mmask8 umask;

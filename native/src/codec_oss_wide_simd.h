@@ -32,7 +32,7 @@
  *   in [0, 2^52))
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
- *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
+ *   root_finish_fine   root_finish good to well below half a layer at t up to 2^24 (K = 4)
  *   SIMD_ISA           the file's sp_isa as a number; from SP_OSS_WIDE_PAIR_ISA_VALUE on, K = 2
  *                      encode past 2^50 grids runs in lanes, which then also needs u_sllv
  *                      (variable left shift), v_from_i_rounded (signed, rounded as C converts),
@@ -124,12 +124,17 @@ SP_INLINE SIMD_FN uvec wide_layer_base(const wide_codec* c, uvec k)
  * with a = 2^32 ah + al, high - (factor 2^32) ah is exact (a multiple of 2^20 below 2^73), the
  * rest rounds only where the sum is past 2^53. So exact for small results, where the roots'
  * arguments cancel, and within 2^-52 of it otherwise. */
+SP_INLINE SIMD_FN vec wide_argument_of_halves(double high, double low, double factor, vec a_high, vec a_low)
+{
+    vec top = v_add(v_fnmadd(a_high, v_splat(factor * 0x1p32), v_splat(high)), v_splat(low));
+    return v_fnmadd(a_low, v_splat(factor), top);
+}
+
 SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec a)
 {
     vec a_high, a_low;
     v_halves(a, &a_high, &a_low);
-    vec top = v_add(v_fnmadd(a_high, v_splat(factor * 0x1p32), v_splat(high)), v_splat(low));
-    return v_fnmadd(a_low, v_splat(factor), top);
+    return wide_argument_of_halves(high, low, factor, a_high, a_low);
 }
 
 /* ---- encode ----------------------------------------------------------------------------- */
@@ -324,33 +329,33 @@ SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, uvec w, vec est
     return ~ok & ((1u << BLOCK) - 1);
 }
 
-/* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
-SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, uvec code)
+/* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code,
+ * from its halves (v_halves). */
+SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, vec high, vec low)
 {
-    return wide_argument(c->root_high, c->root_low, 144.0, code);
+    return wide_argument_of_halves(c->root_high, c->root_low, 144.0, high, low);
 }
 
-/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate) from its root t of
- * t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the widest codes
- * (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic first (its
- * cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
-SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
+/* K = 4: rest w = code - u(k) for the estimated layer k, all in double lanes (no 64-bit
+ * products: AVX2 builds each from three 32-bit ones), from the code's 32-bit halves (v_halves).
+ * u(k) = A k + floor((r k + 2) / 9) with A = floor(c / 9) and r = c mod 9 (wide_layer_split's
+ * form: c < 2^48, A < 2^45, k < 2^22), and A k = p + e exactly, p the rounded product and
+ * e = A k - p by FMA, so w = (((2^32 high - p) - e) + low) - floor((r k + 2) / 9). The first
+ * difference rounds once, to itself wherever its integer value is below 2^53, and each later
+ * step is exact while its sum stays below 2^53; so a step that rounds leaves a magnitude past
+ * 2^53, and the rest ends past 2^52 either way (negative or not, as the exact rest). A rest in
+ * the layer (below 2^44) is thus exact, and one past it (a wrong layer estimate) stays outside
+ * every layer's triangle: the row check, which accepts only a rest inside the triangle, proves
+ * the layer. */
+SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, vec high, vec low, vec k)
 {
-    if (WIDE_ROOT_NEWTON) {
-        vec square = v_mul(t, t);
-        vec excess = v_fmsub(t, v_sub(square, v_splat(3.0)), x);
-        t = v_sub(t, v_div(excess, v_fmsub(square, v_splat(3.0), v_splat(3.0))));
-    }
-    return layer_estimate(c->n, t);
-}
-
-/* K = 4: rest = code - u(k) for the estimated layer k in double lanes: exact below 2^52, and a
- * rest past that (a wrong layer estimate: a negative rest wraps) stays past every layer's codes,
- * rounded as it may be. The row check then proves the layer: it accepts only a rest inside the
- * layer's triangle. */
-SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, uvec code, vec layer)
-{
-    return v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(layer))));
+    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
+    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
+    vec small = v_floor(v_mul(v_fmadd(v_fnmadd(ninth, v_splat(9.0), inner), k, v_splat(2.5)), v_splat(1.0 / 9.0)));
+    vec product = v_mul(ninth, k), error = v_fmsub(ninth, k, product);
+    vec difference = v_fmsub(high, v_splat(0x1p32), product);
+    return v_sub(v_add(v_sub(difference, error), low), small);
 }
 
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
@@ -363,19 +368,21 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     const wide_codec* c = (const wide_codec*)constants;
     double inverse = 1.0 / (double)codec->scale;
     vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
+    vec high[DECODE_CHUNK], low[DECODE_CHUNK]; /* K = 4: the codes' 32-bit halves */
     root z[DECODE_CHUNK];
-    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
     if (!check_passed(&check)) return 0;
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
-            x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
+            v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
+            x[b] = wide_layer_argument(c, high[b], low[b]);
             z[b] = root_start(x[b]);
         }
-        for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
+        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
         for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_layer_rest(c, u_load(codes + b * BLOCK), layer[b]);
+            rest[b] = wide_layer_rest(c, high[b], low[b], layer[b]);
             bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
         }
         for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */
@@ -399,8 +406,9 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
             missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
             store_weights(q, 4, inverse, layout, out);
         }
+        any |= missed[b];
     }
-    redo_decode(codec, codes, blocks, BLOCK, missed, k, weights);
+    if (any) redo_decode(codec, codes, blocks, BLOCK, missed, k, weights); /* most chunks have none */
     return 1;
 }
 
