@@ -338,17 +338,19 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root zf)
     return _mm256_fmadd_pd(r, slope, _mm256_add_pd(c, z));
 }
 
-/* root_finish to second order in r for the wide lanes, whose t reaches 2^24 (root_finish's
+/* root_finish to third order in r for the wide lanes, whose t reaches 2^24 (root_finish's
  * ~1e-8 is up to 0.3 of t there), without the division of a Newton step: with x z^3 = 1 - r,
- * x^(1/3) = c (1 - r)^(-2/3) = c (1 + 2r/3 + 5r^2/9 + O(r^3)). r stays below ~6e-4 after
- * root_start, so that is good to ~1e-10 relative (~2e-3 of t); 1/cbrt(x) = z (1 + r/3 + ...)
- * is taken as z, at most ~2e-4 off as z <= 1. */
+ * x^(1/3) = c (1 - r)^(-2/3) = c (1 + 2r/3 + 5r^2/9 + 40r^3/81 + O(r^4)). r stays below ~6e-4
+ * after root_start, so that is good to ~1e-13 relative (~1e-6 of t, 3e-7 of a layer: the
+ * Newton step's accuracy for every code but those next to a layer start, ~2 rows of the
+ * largest layers; a second-order series left ~700); 1/cbrt(x) = z (1 + r/3 + ...) is taken
+ * as z, off by r z / 3 <= 2e-4 of t, 2e-10 where t is large (z ~ 1/t). */
 SP_INLINE SIMD_FN vec root_finish_fine(vec x, root zf)
 {
     __m256d z = _mm256_cvtps_pd(zf), xz = _mm256_mul_pd(x, z);
     __m256d r = _mm256_fnmadd_pd(xz, _mm256_mul_pd(z, z), v_splat(1.0));
     __m256d c = _mm256_mul_pd(xz, z);
-    __m256d series = _mm256_fmadd_pd(r, v_splat(5.0 / 9.0), v_splat(2.0 / 3.0));
+    __m256d series = _mm256_fmadd_pd(_mm256_fmadd_pd(r, v_splat(40.0 / 81.0), v_splat(5.0 / 9.0)), r, v_splat(2.0 / 3.0));
     return _mm256_fmadd_pd(_mm256_mul_pd(c, r), series, _mm256_add_pd(c, z));
 }
 
