@@ -254,12 +254,12 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
  * step (~1e-5 of a row, from the argument's and the square root's rounding at 2^-52 of values up
  * to 2^34), so floored, it is the row or the one before it, and one compare going up settles it.
  * K = 4's layer estimate is taken as codec_oss_simd.h takes it, unbiased (AVX-512's root and
- * AVX2's after its Newton step are off by far less than half a layer: no lane of the tests' tens
- * of millions missed by more), without a settling step: the rare code that close to a layer
+ * AVX2's root_finish_fine are off by far less than half a layer: no lane of the tests' tens of
+ * millions missed by more), without a settling step: the rare code that close to a layer
  * boundary lands in the wrong layer, and the row check sends it to the scalar code (a step up
  * settled every lane but cost ~10% of the decode, on the bench's mix and on random codes alike).
  * Lanes the checks reject are redone, whatever the estimate was (checked with estimates biased
- * by two steps and more).
+ * by -2, -1, 1, 2 and 7 steps: every output right, test_batch_wide_lanes's redo counts failing).
  */
 
 /* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w, from its halves
