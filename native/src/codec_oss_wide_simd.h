@@ -334,9 +334,12 @@ SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, vec high, vec low, ve
 }
 
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
- * codec_oss_simd.h (K = 4: the layer root's two halves, the layer and the row estimate, the rest;
- * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed; nothing
- * written where a code is above max_code (returns 0); constants: the wide_codec. */
+ * codec_oss_simd.h (K = 4: the code check, the codes' halves and the layer root's float start;
+ * the root's finish and the layer; the rest and the row estimate, in one stage: ~10% faster than
+ * two on AVX2, where moving the root's finish or the row's square root into a neighbouring
+ * stage ran 10-15% slower; the rest. K = 3: the code check and the row estimate, the rest),
+ * then the scalar redo of the lanes it missed; nothing written where a code is above max_code
+ * (returns 0); constants: the wide_codec. */
 SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
