@@ -361,6 +361,17 @@ SP_INLINE SIMD_FN root root_start(vec x)
     return _mm_fmadd_ps(_mm_mul_ps(z, r), _mm_fmadd_ps(r, _mm_set1_ps(2.0f / 9.0f), _mm_set1_ps(1.0f / 3.0f)), z);
 }
 
+/* root_start of two blocks in one pass of eight float lanes (the same operations, lane by lane). */
+SP_INLINE SIMD_FN void root_start_pair(vec a, vec b, root* first, root* second)
+{
+    __m256 xf = _mm256_set_m128(_mm256_cvtpd_ps(b), _mm256_cvtpd_ps(a));
+    __m256i third = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_castps_si256(xf)), _mm256_set1_ps(1.0f / 3.0f)));
+    __m256 z = _mm256_castsi256_ps(_mm256_sub_epi32(_mm256_set1_epi32(1419916032), third));
+    __m256 r = _mm256_fnmadd_ps(_mm256_mul_ps(xf, z), _mm256_mul_ps(z, z), _mm256_set1_ps(1.0f));
+    __m256 y = _mm256_fmadd_ps(_mm256_mul_ps(z, r), _mm256_fmadd_ps(r, _mm256_set1_ps(2.0f / 9.0f), _mm256_set1_ps(1.0f / 3.0f)), z);
+    *first = _mm256_castps256_ps128(y), *second = _mm256_extractf128_ps(y, 1);
+}
+
 SP_INLINE SIMD_FN vec root_finish(vec x, root zf)
 {
     __m256d z = _mm256_cvtps_pd(zf), xz = _mm256_mul_pd(x, z);
@@ -370,13 +381,27 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root zf)
     return _mm256_fmadd_pd(r, slope, _mm256_add_pd(c, z));
 }
 
+/* root_finish to third order in r for the wide lanes, whose t reaches 2^24 (root_finish's
+ * ~1e-8 is up to 0.3 of t there), without the division of a Newton step: with x z^3 = 1 - r,
+ * x^(1/3) = c (1 - r)^(-2/3) = c (1 + 2r/3 + 5r^2/9 + 40r^3/81 + O(r^4)). r stays below ~6e-4
+ * after root_start, so that is good to ~1e-13 relative (~1e-6 of t, 3e-7 of a layer: the
+ * Newton step's accuracy for every code but those next to a layer start, ~2 rows of the
+ * largest layers; a second-order series left ~700); 1/cbrt(x) = z (1 + r/3 + ...) is taken
+ * as z, off by r z / 3 <= 2e-4 of t, 2e-10 where t is large (z ~ 1/t). */
+SP_INLINE SIMD_FN vec root_finish_fine(vec x, root zf)
+{
+    __m256d z = _mm256_cvtps_pd(zf), xz = _mm256_mul_pd(x, z);
+    __m256d r = _mm256_fnmadd_pd(xz, _mm256_mul_pd(z, z), v_splat(1.0));
+    __m256d c = _mm256_mul_pd(xz, z);
+    __m256d series = _mm256_fmadd_pd(_mm256_fmadd_pd(r, v_splat(40.0 / 81.0), v_splat(5.0 / 9.0)), r, v_splat(2.0 / 3.0));
+    return _mm256_fmadd_pd(_mm256_mul_pd(c, r), series, _mm256_add_pd(c, z));
+}
+
 /* The 64-bit integer lanes of the wide driver (codec_oss_wide_simd.h). AVX2 has no 64-bit
  * multiply or unsigned compare: products come from 32-bit pieces (_mm256_mul_epu32), compares
  * are signed ones with the sign bits flipped. */
 
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx2
-
-#define WIDE_ROOT_NEWTON 1 /* its cube root is ~4e-8 off in places */
 
 typedef __m256i uvec;
 typedef __m256i umask; /* all-ones lanes */

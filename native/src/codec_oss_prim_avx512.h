@@ -291,7 +291,14 @@ SP_INLINE SIMD_FN vec root_finish(vec x, root yf)
 
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx512
 
-#define WIDE_ROOT_NEWTON 0 /* its root (a double Newton step) is good to far below half a layer */
+/* Its root_start already fills eight float lanes a block (a sixteen-lane pass ran ~1% faster). */
+SP_INLINE SIMD_FN void root_start_pair(vec a, vec b, root* first, root* second)
+{
+    *first = root_start(a), *second = root_start(b);
+}
+
+/* Its root (a double Newton step) is good to far below half a layer at the wide lanes' t. */
+SP_INLINE SIMD_FN vec root_finish_fine(vec x, root yf) { return root_finish(x, yf); }
 
 typedef __m512i uvec;
 typedef __mmask8 umask;

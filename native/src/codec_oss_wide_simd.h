@@ -4,13 +4,13 @@
  * codec_oss_simd.h, whose primitives, rounding and estimates it reuses).
  *
  * Past the double lanes' exact range (codec_oss_batch.c: layer and row bases past 2^50) the
- * bases run in 64-bit integer lanes. Grid coordinates and codes fit 64 bits, and where an
- * intermediate does not, the arithmetic is modulo 2^64 with a final value below 2^64:
- *   - the row base s_N(j) = floor(((4N + 2 - 3j) j + 1) / 4) as j (N - j) + floor((j + 1)^2 / 4),
- *     since a floor by 4 does not commute with a reduction mod 2^64;
- *   - the layer base u(k) = (a - r) / 9 with a its numerator mod 2^64, r = a mod 9 (which for a
- *     given N depends only on k mod 3: a table of three in one word), and the exact division as
- *     a product with 9's inverse mod 2^64.
+ * codes run in 64-bit integer lanes. Grid coordinates and codes fit 64 bits. Encode sums the
+ * bases modulo 2^64 to a final value below 2^64 (the row base s_N(j) = floor(((4N + 2 - 3j) j +
+ * 1) / 4) as j (N - j) + floor((j + 1)^2 / 4), since a floor by 4 does not commute with a
+ * reduction mod 2^64). Decode needs only the differences code - base, which are small where
+ * they matter, so it takes them in double lanes from the code's 32-bit halves and a base split
+ * into an exact FMA product and its residual (wide_layer_rest, wide_row_offset): exact wherever
+ * the difference lies in or next to the row or layer, past every row's codes elsewhere.
  * The root estimates stay in double lanes: their arguments (apex^2 + 3 - 12w for rows,
  * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
  * (wide_argument), so they are exact where small (near the apex, where a rounded code would
@@ -33,15 +33,13 @@
  *   in [0, 2^52))
  *   store_pairs(q0, q1, inverse, layout, out), store_triples(q, inverse, layout, out):
  *                      store_weights for K = 2 and 3
- *   WIDE_ROOT_NEWTON   1: refine codec_oss_simd.h's layer root (see wide_layer_estimate)
+ *   root_finish_fine   root_finish good to well below half a layer at t up to 2^24 (K = 4)
+ *   root_start_pair(a, b, &ra, &rb)  root_start of two blocks (in one pass where the ISA can)
  *   load_pairs(w, &first, &second) (K = 2 weights as two component vectors), m_eq,
  *   v_keep_where(x, m) = m ? x : +0, v_below_where(x, m) (the double below x > 0 where m),
  *   u_bits (a vec's bits as they are): for K = 2 encode past 2^50 grids (wide_pair_start)
  * and WIDE_NAME(name), the entry points' names.
  */
-
-/* 9 u mod 2^64 -> u: 9 * INVERSE_OF_9 = 1 mod 2^64. */
-#define INVERSE_OF_9 0x8E38E38E38E38E39ull
 
 /* The per-codec constants of the wide lanes (mod 2^64 where marked). */
 typedef struct wide_codec {
@@ -50,9 +48,6 @@ typedef struct wide_codec {
     uint64_t n_bits, scale_bits;
     double mirrored_high, mirrored_low; /* (2N + 1)^2 + 3 - 10.5 as two exact doubles (K = 3) */
     double apex, last_row;
-    uint64_t rows;            /* (2N + 1) / 3 (K = 3) */
-    uint64_t layer_c1, layer_c0; /* 6N + 9, 3N^2 + 9N + 6 mod 2^64 (K = 4) */
-    uint64_t layer_remainders;   /* 4 bits each: u(k)'s numerator mod 9 for k mod 3 = 0, 1, 2 */
     double root_high, root_low;  /* 8M^3 + 12M^2 - 106 (M = N + 1) as two exact doubles (K = 4) */
 } wide_codec;
 
@@ -77,20 +72,10 @@ static wide_codec wide_codec_for(const sp_codec* codec)
     split_exactly(square, &c.mirrored_high, &c.mirrored_low);
     c.mirrored_low -= 10.5; /* the row estimate's w + 7/8, times 12 */
     c.apex = (double)apex, c.last_row = (double)((2 * n + 1) / 3 - 1);
-    c.rows = (2 * n + 1) / 3;
-    c.layer_c1 = 6 * n + 9, c.layer_c0 = 3 * n * n + 9 * n + 6;
     sp_u128 m2 = sp_u128_mul(sp_u128_from(m), sp_u128_from(m));
     sp_u128 root = sp_u128_sub(sp_u128_add(sp_u128_mul_u64(sp_u128_mul_u64(m2, m), 8), sp_u128_mul_u64(m2, 12)),
                                sp_u128_from(106));
     split_exactly(root, &c.root_high, &c.root_low);
-    /* 3Nk(N - 2k + 3) + k(4k^2 - 9k + 6) + 2 mod 9 with N mod 9 and k mod 3 for N and k: the first
-     * term is 3 times something taken mod 3, the second 4k^3 + 6k mod 9, and (k + 3)^3 = k^3 mod 9. */
-    int64_t nm = (int64_t)(n % 9);
-    c.layer_remainders = 0;
-    for (int64_t k = 0; k < 3; ++k) {
-        int64_t a = 3 * nm * k * (nm - 2 * k + 3) + k * (4 * k * k - 9 * k + 6) + 2;
-        c.layer_remainders |= (uint64_t)(((a % 9) + 9) % 9) << (4 * k);
-    }
     return c;
 }
 
@@ -104,33 +89,12 @@ SP_INLINE SIMD_FN uvec wide_row_base(const wide_codec* c, uvec j)
     return u_add(u_mul(j, u_sub(u_splat(c->n_bits), j)), u_mul32(half, half_up));
 }
 
-/* Codes in row j, floor((2N - 3j) / 2) = N - j - (j + 1) / 2 (at least 1 for rows j < rows). */
-SP_INLINE SIMD_FN uvec wide_row_length(const wide_codec* c, uvec j)
-{
-    return u_sub(u_sub(u_splat(c->n_bits), j), u_srl(u_add(j, u_splat(1)), 1));
-}
-
-/* u(k) = floor(a / 9), a = ((4k - 6N - 9) k + 3N^2 + 9N + 6) k + 2 (Horner, mod 2^64), for layers
- * k < 2^32: (a - a mod 9) times 9's inverse. k mod 3 from floor(k / 3) = k 0xAAAAAAAB / 2^33. */
-SP_INLINE SIMD_FN uvec wide_layer_base(const wide_codec* c, uvec k)
-{
-    uvec third = u_srl(u_mul32(k, u_splat(0xAAAAAAABu)), 33);
-    uvec k_mod3 = u_sub(k, u_add(third, u_add(third, third)));
-    uvec r = u_and(u_srlv(u_splat(c->layer_remainders), u_sll(k_mod3, 2)), u_splat(15));
-    uvec a = u_sub(u_sll(k, 2), u_splat(c->layer_c1));
-    a = u_add(u_mul_u32(a, k), u_splat(c->layer_c0));
-    a = u_add(u_mul_u32(a, k), u_splat(2));
-    return u_mul(u_sub(a, r), u_splat(INVERSE_OF_9));
-}
-
 /* high + low - factor a for a code a (factor 12 or 144, high + low < 2^73 from split_exactly):
  * with a = 2^32 ah + al, high - (factor 2^32) ah is exact (a multiple of 2^20 below 2^73), the
  * rest rounds only where the sum is past 2^53. So exact for small results, where the roots'
  * arguments cancel, and within 2^-52 of it otherwise. */
-SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec a)
+SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, vec a_high, vec a_low)
 {
-    vec a_high, a_low;
-    v_halves(a, &a_high, &a_low);
     vec top = v_add(v_fnmadd(a_high, v_splat(factor * 0x1p32), v_splat(high)), v_splat(low));
     return v_fnmadd(a_low, v_splat(factor), top);
 }
@@ -142,8 +106,9 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, uvec
  * with r = c mod 9: c (below 2^46 at 64-bit codes, and positive for k <= (N + 1) / 2) and its
  * quotient are exact doubles, the quotient's floor codec_oss_simd.h's biased_ninth (of c - 4,
  * the 4 taken off the constant), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
- * 2^64 as the sum is below 2^64) needs the integer lanes: one product where wide_layer_base
- * takes three and a table. Returns floor(c / 9) k; *small = ROUNDING_MAGIC + floor((r k + 2) / 9). */
+ * 2^64 as the sum is below 2^64) needs the integer lanes: one product where the exact division
+ * by 9 modulo 2^64 took three and a table. Returns floor(c / 9) k; *small = ROUNDING_MAGIC +
+ * floor((r k + 2) / 9). */
 SP_INLINE SIMD_FN uvec wide_layer_split(const wide_codec* c, vec k, vec* small)
 {
     vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
@@ -314,97 +279,120 @@ SIMD_FN size_t WIDE_NAME(encode)(const sp_codec* codec, const float* weights, si
  * step (~1e-5 of a row, from the argument's and the square root's rounding at 2^-52 of values up
  * to 2^34), so floored, it is the row or the one before it, and one compare going up settles it.
  * K = 4's layer estimate is taken as codec_oss_simd.h takes it, unbiased (AVX-512's root and
- * AVX2's after its Newton step are off by far less than half a layer: no lane of the tests' tens
- * of millions missed by more), without a settling step: the rare code that close to a layer
+ * AVX2's root_finish_fine are off by far less than half a layer: no lane of the tests' tens of
+ * millions missed by more), without a settling step: the rare code that close to a layer
  * boundary lands in the wrong layer, and the row check sends it to the scalar code (a step up
  * settled every lane but cost ~10% of the decode, on the bench's mix and on random codes alike).
  * Lanes the checks reject are redone, whatever the estimate was (checked with estimates biased
- * by two steps and more).
+ * by -2, -1, 1, 2 and 7 steps: every output right, test_batch_wide_lanes's redo counts failing).
  */
 
-/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w (the mirrored
- * root's argument apex^2 + 3 - 12(w + 7/8) from wide_argument), half a row low, floored and
- * clamped to the rows. */
-SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, uvec w)
+/* K = 3: the row estimate of codec_oss_simd.h for w + 7/8 on a 64-bit code w, from its halves
+ * (v_halves; the mirrored root's argument apex^2 + 3 - 12(w + 7/8) by wide_argument), half a
+ * row low, floored and clamped to the rows. */
+SP_INLINE SIMD_FN vec wide_row_estimate(const wide_codec* c, vec high, vec low)
 {
-    vec mirrored = wide_argument(c->mirrored_high, c->mirrored_low, 12.0, w);
+    vec mirrored = wide_argument(c->mirrored_high, c->mirrored_low, 12.0, high, low);
     vec root = v_sqrt(v_max(mirrored, v_zero()));
     return clamp_floor(v_fmsub(v_sub(v_splat(c->apex), root), v_splat(1.0 / 3.0), v_splat(0.5)), v_splat(c->last_row));
 }
 
-/* K = 3: the row j of code w from its estimate (j or j - 1), and i = w - s_N(j), into q; returns
- * the lanes whose (j, i) is not proven right (i outside row j, or j past the last row, whose
- * length formula wraps: a step up from the last row, which only an estimate off by more than the
- * bound takes), as bits. */
-SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, uvec w, vec estimate, vec* q)
+/* K = 3: i = w - s_N(j) for a 64-bit code w from its halves and a row j < 2^33, in double lanes
+ * (no 64-bit products, as wide_layer_rest): s_N(j) = floor(a j + 1/4) with a = N + 1/2 - 3j/4
+ * (a multiple of 1/4), a j = p + e exactly (p the rounded product, e by FMA), and
+ * s_N(j) - w = floor(((e - (2^32 high - p)) - low) + 1/4). The difference rounds once, to
+ * itself wherever it is below 2^51 (a multiple of 1/4), and each later step is exact while its
+ * sum stays below 2^51; so a step that rounds leaves a magnitude past 2^51, and i ends past 2^50
+ * either way. For w in row j or j + 1 (i below 2^35) i is exact; else it is outside both. */
+SP_INLINE SIMD_FN vec wide_row_offset(const wide_codec* c, vec high, vec low, vec j)
 {
-    uvec j = u_from_v(estimate), length = wide_row_length(c, j), i = u_sub(w, wide_row_base(c, j));
-    umask above = u_lt(u_sub(length, u_splat(1)), i); /* i >= length: the next row */
-    j = u_select(above, u_add(j, u_splat(1)), j);
-    i = u_select(above, u_sub(i, length), i);
-    unsigned ok = um_bits(u_lt(i, wide_row_length(c, j))) & um_bits(u_lt_small(j, u_splat(c->rows))); /* i < 0 wraps */
-    unpacked_block(c->n, 3, v_zero(), v_from_u(j), v_from_u(i), q);
+    vec slope = v_fnmadd(j, v_splat(0.75), v_splat(c->n + 0.5));
+    vec product = v_mul(slope, j), error = v_fmsub(slope, j, product);
+    vec difference = v_fmsub(high, v_splat(0x1p32), product);
+    return v_sub(v_zero(), v_floor(v_add(v_sub(v_sub(error, difference), low), v_splat(0.25))));
+}
+
+/* K = 3: the row j of code w from its estimate (j or j - 1) by one step up, and i = w - s_N(j),
+ * into q; returns the lanes whose (j, i) is not proven right (i outside row j, as row_offset
+ * checks it: rows j >= rows have no codes), as bits. Exact: i is (wide_row_offset) wherever it
+ * can pass, rows and lengths are integers and halves below 2^35. */
+SP_INLINE SIMD_FN unsigned wide_unpack_rows(const wide_codec* c, vec high, vec low, vec j, vec* q)
+{
+    vec i = wide_row_offset(c, high, low, j), length = v_floor(v_fnmadd(j, v_splat(1.5), v_splat(c->n)));
+    mask above = m_ge(i, length); /* the next row */
+    j = v_add_where(j, above, v_splat(1.0));
+    i = v_add_where(i, above, v_sub(v_zero(), length));
+    vec last = v_fnmadd(j, v_splat(1.5), v_splat(c->n - 1.0));
+    unsigned ok = m_bits(m_and(m_ge(i, v_zero()), m_ge(last, i)));
+    unpacked_block(c->n, 3, v_zero(), j, i, q);
     return ~ok & ((1u << BLOCK) - 1);
 }
 
-/* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code. */
-SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, uvec code)
+/* K = 4: the layer argument of codec_oss_simd.h's estimate (for code + 17/18) on a 64-bit code,
+ * from its halves (v_halves). */
+SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, vec high, vec low)
 {
-    return wide_argument(c->root_high, c->root_low, 144.0, code);
+    return wide_argument(c->root_high, c->root_low, 144.0, high, low);
 }
 
-/* K = 4: the layer estimate of codec_oss_simd.h (layer_estimate) from its root t of
- * t^3 - 3t = x. Where the ISA's root is not good to well below half a layer at the widest codes
- * (AVX2's, ~4e-8 relative in places: t reaches 2^24), one Newton step on that cubic first (its
- * cancellation costs ~2^17 of t^3 ~ 2^72, 2^-31 of t). */
-SP_INLINE SIMD_FN vec wide_layer_estimate(const wide_codec* c, vec x, vec t)
+/* K = 4: rest w = code - u(k) for the estimated layer k, all in double lanes (no 64-bit
+ * products: AVX2 builds each from three 32-bit ones), from the code's 32-bit halves (v_halves).
+ * u(k) = A k + floor((r k + 2) / 9) with A = floor(c / 9) and r = c mod 9 (wide_layer_split's
+ * form: c < 2^48, A < 2^45, k < 2^22), and A k = p + e exactly, p the rounded product and
+ * e = A k - p by FMA, so w = (((2^32 high - p) - e) + low) - floor((r k + 2) / 9). The first
+ * difference rounds once, to itself wherever its integer value is below 2^53, and each later
+ * step is exact while its sum stays below 2^53; so a step that rounds leaves a magnitude past
+ * 2^53, and the rest ends past 2^52 either way (negative or not, as the exact rest). A rest in
+ * the layer (below 2^44) is thus exact, and one past it (a wrong layer estimate) stays outside
+ * every layer's triangle: the row check, which accepts only a rest inside the triangle, proves
+ * the layer. */
+SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, vec high, vec low, vec k)
 {
-    if (WIDE_ROOT_NEWTON) {
-        vec square = v_mul(t, t);
-        vec excess = v_fmsub(t, v_sub(square, v_splat(3.0)), x);
-        t = v_sub(t, v_div(excess, v_fmsub(square, v_splat(3.0), v_splat(3.0))));
-    }
-    return layer_estimate(c->n, t);
-}
-
-/* K = 4: rest = code - u(k) for the estimated layer k in double lanes: exact below 2^52, and a
- * rest past that (a wrong layer estimate: a negative rest wraps) stays past every layer's codes,
- * rounded as it may be. The row check then proves the layer: it accepts only a rest inside the
- * layer's triangle. */
-SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, uvec code, vec layer)
-{
-    return v_from_u_rounded(u_sub(code, wide_layer_base(c, u_from_v(layer))));
+    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
+    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
+    vec small = v_floor(v_mul(v_fmadd(v_fnmadd(ninth, v_splat(9.0), inner), k, v_splat(2.5)), v_splat(1.0 / 9.0)));
+    vec product = v_mul(ninth, k), error = v_fmsub(ninth, k, product);
+    vec difference = v_fmsub(high, v_splat(0x1p32), product);
+    return v_sub(v_add(v_sub(difference, error), low), small);
 }
 
 /* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
- * codec_oss_simd.h (K = 4: the layer root's two halves, the layer and the row estimate, the rest;
- * K = 3: the row estimate, the rest), then the scalar redo of the lanes it missed; nothing
- * written where a code is above max_code (returns 0); constants: the wide_codec. */
+ * codec_oss_simd.h (K = 4: the code check, the codes' halves and the layer root's float start;
+ * the root's finish and the layer; the rest and the row estimate, in one stage: ~10% faster than
+ * two on AVX2, where moving the root's finish or the row's square root into a neighbouring
+ * stage ran 10-15% slower; the rest. K = 3: the code check and the row estimate, the rest),
+ * then the scalar redo of the lanes it missed; nothing written where a code is above max_code
+ * (returns 0); constants: the wide_codec. */
 SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
     const wide_codec* c = (const wide_codec*)constants;
     double inverse = 1.0 / (double)codec->scale;
     vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
+    vec high[DECODE_CHUNK], low[DECODE_CHUNK]; /* the codes' 32-bit halves (K = 3, 4) */
     root z[DECODE_CHUNK];
-    unsigned missed[DECODE_CHUNK]; /* lanes as bits */
+    unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
-    for (size_t b = 0; b < blocks; ++b) load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
-    if (!check_passed(&check)) return 0;
-    if (k == 4) {
-        for (size_t b = 0; b < blocks; ++b) {
-            x[b] = wide_layer_argument(c, u_load(codes + b * BLOCK));
-            z[b] = root_start(x[b]);
+    for (size_t b = 0; b < blocks; ++b) {
+        load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
+        if (k > 2) v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
+        if (k == 4) {
+            x[b] = wide_layer_argument(c, high[b], low[b]);
+            if (b % 2) root_start_pair(x[b - 1], x[b], &z[b - 1], &z[b]); /* ~5% faster on AVX2 than one by one */
+            else if (b + 1 == blocks) z[b] = root_start(x[b]);
         }
-        for (size_t b = 0; b < blocks; ++b) layer[b] = wide_layer_estimate(c, x[b], root_finish(x[b], z[b]));
-        for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_layer_rest(c, u_load(codes + b * BLOCK), layer[b]);
-            bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
-        }
-        for (size_t b = 0; b < blocks; ++b) row[b] = row_estimate(bottom[b], rest[b]); /* a stage of its own: sqrt */
+        if (k == 3) row[b] = wide_row_estimate(c, high[b], low[b]);
     }
-    if (k == 3)
-        for (size_t b = 0; b < blocks; ++b) row[b] = wide_row_estimate(c, u_load(codes + b * BLOCK));
+    if (!check_passed(&check)) return 0; /* nothing written yet */
+    if (k == 4) {
+        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
+        for (size_t b = 0; b < blocks; ++b) {
+            rest[b] = wide_layer_rest(c, high[b], low[b], layer[b]);
+            bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
+            row[b] = row_estimate(bottom[b], rest[b]);
+        }
+    }
     for (size_t b = 0; b < blocks; ++b) {
         vec q[SP_MAX_INFLUENCES];
         uvec code = u_load(codes + b * BLOCK);
@@ -413,7 +401,7 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
         if (k == 2) { /* no grid vectors to build */
             store_pairs(v_from_u_rounded(u_sub(u_splat(c->scale_bits), code)), v_from_u_rounded(code), inverse, layout, out);
         } else if (k == 3) {
-            missed[b] = wide_unpack_rows(c, code, row[b], q);
+            missed[b] = wide_unpack_rows(c, high[b], low[b], row[b], q);
             store_triples(q, inverse, layout, out);
         } else {
             mask ok;
@@ -422,8 +410,9 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
             missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
             store_weights(q, 4, inverse, layout, out);
         }
+        any |= missed[b];
     }
-    redo_decode(codec, codes, blocks, BLOCK, missed, k, weights);
+    if (any) redo_decode(codec, codes, blocks, BLOCK, missed, k, weights); /* most chunks have none */
     return 1;
 }
 

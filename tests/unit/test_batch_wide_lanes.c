@@ -1,0 +1,144 @@
+/*
+ * What the wide decode lanes decode themselves (codec_oss_wide_simd.h, K = 3 past N = 2^24 and
+ * K = 4 past N = 3 * 2^15; AVX2, or AVX-512 where built with LANES_AVX512). test_batch_wide.c
+ * compares their output with the scalar code, but a lane they reject is redone by the scalar
+ * code, so a broken rest or row offset (one that rejected every lane) would pass it. Here the
+ * ISA's driver is compiled into the test with the scalar redo counted: every output still bit-identical, and the redone lanes few, for random
+ * codes and for the codes around row starts (where K = 3's estimate, half a row low, must take
+ * the step up, and K = 4's rows sit deep inside their layer), up to 64-bit codes.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../native/src/codec_internal.h"
+
+#include "check.h"
+#include "skinpack.h"
+
+#if SP_X86_SIMD
+/* The driver's scalar redo, counted. */
+static size_t redone = 0;
+static void counted_decode_one(const sp_codec* codec, uint64_t code, float* weights)
+{
+    ++redone;
+    sp_oss_decode_one(codec, code, weights);
+}
+#define sp_oss_decode_one counted_decode_one
+
+#include "../../native/src/codec_oss_wide.h"
+#if LANES_AVX512
+#include "../../native/src/codec_oss_prim_avx512.h"
+#define LANES_ISA SP_ISA_AVX512
+#define LANES_TEST "test_batch_wide_lanes_avx512"
+#else
+#include "../../native/src/codec_oss_prim_avx2.h"
+#define LANES_ISA SP_ISA_AVX2
+#define LANES_TEST "test_batch_wide_lanes"
+#endif
+#undef SIMD_NAME
+#define SIMD_NAME(name) counted_##name /* not the library's entry points */
+#undef WIDE_NAME
+#define WIDE_NAME(name) counted_wide_##name
+#include "../../native/src/codec_oss_simd.h"
+#include "../../native/src/codec_oss_wide_simd.h"
+#undef sp_oss_decode_one
+
+static sp_codec oss(uint32_t k, uint64_t n)
+{
+    sp_codec c;
+    CHECK(sp_codec_from_params(SP_METHOD_OSS, k, n, NULL, &c) == SP_OK);
+    return c;
+}
+
+/* Decodes `count` codes through the counted lanes: every vertex of the full blocks taken, each
+ * bit-identical to sp_decode_weights; returns the lanes redone. */
+static size_t decode_counted(const sp_codec* c, const uint64_t* codes, size_t count, const char* what)
+{
+    uint32_t k = c->influences;
+    float* w = malloc(count * k * sizeof(float));
+    float ref[SP_MAX_INFLUENCES];
+    redone = 0;
+    size_t done = counted_wide_decode(c, codes, count, w);
+    CHECK_MSG(done == count / BLOCK * BLOCK, "%s K=%u N=%llu: %zu of %zu done", what, k, (unsigned long long)c->n, done, count);
+    for (size_t v = 0, failures = 0; v < done && failures < 5; ++v) {
+        sp_decode_weights(c, codes[v], ref);
+        int same = memcmp(w + v * k, ref, k * sizeof(float)) == 0;
+        CHECK_MSG(same, "%s K=%u N=%llu code %llu", what, k, (unsigned long long)c->n, (unsigned long long)codes[v]);
+        failures += !same;
+    }
+    free(w);
+    return redone;
+}
+
+/* Random valid codes: the estimates miss about one in 10^5 (none in these runs), so more than
+ * one in 10^3 redone means the lanes reject what they should decode. */
+static void random_codes(const sp_codec* c)
+{
+    size_t count = 40000;
+    uint64_t* codes = malloc(count * sizeof(uint64_t));
+    for (size_t v = 0; v < count; ++v) codes[v] = c->max_code == UINT64_MAX ? rng_next() : rng_next() % (c->max_code + 1);
+    size_t redo = decode_counted(c, codes, count, "random");
+    CHECK_MSG(redo <= count / 1000, "random K=%u N=%llu: %zu of %zu lanes redone", c->influences, (unsigned long long)c->n,
+              redo, count);
+    free(codes);
+}
+
+/* The codes s - 2 .. s + 1 around 4000 row starts s: K = 3 rows 2 .. 2001 and the last ones
+ * but the last two (where the estimate, half a row low, must take the step up), K = 4 rows
+ * spread over the middle of the triangle of layer `layer` (rests up to 2^44, away from its ends,
+ * where a code may land in the next or previous layer and be redone). None may be redone: each
+ * is the last code of a row or one of the first two, decided by the exact double forms. */
+static void row_starts(const sp_codec* c, uint64_t layer)
+{
+    uint64_t bottom = c->n - 2 * layer, rows = (2 * bottom + 1) / 3;
+    uint64_t base = c->influences == 4 ? sp_oss_layer_base(c->n, layer) : 0;
+    size_t count = 0;
+    uint64_t* codes = malloc(4 * 4000 * sizeof(uint64_t));
+    for (uint64_t s = 0; s < 4000; ++s) {
+        uint64_t j = c->influences == 4 ? rows / 3 + s * (rows / 2) / 4000 : s < 2000 ? s + 2 : rows - 2 - (s - 2000);
+        for (uint64_t d = 0; d < 4; ++d) codes[count++] = base + sp_oss_row_base(bottom, j) + d - 2;
+    }
+    size_t redo = decode_counted(c, codes, count, "row starts");
+    CHECK_MSG(redo == 0, "row starts K=%u N=%llu layer %llu: %zu of %zu lanes redone", c->influences,
+              (unsigned long long)c->n, (unsigned long long)layer, redo, count);
+    free(codes);
+}
+
+static void check_codec(const sp_codec* c)
+{
+    random_codes(c);
+    if (c->influences == 3) row_starts(c, 0);
+    else {
+        uint64_t layers = (c->n + 1) / 2;
+        row_starts(c, 0);
+        row_starts(c, layers / 3);
+        row_starts(c, layers - 3000);
+    }
+}
+
+int main(void)
+{
+    if (sp_cpu_isa() < LANES_ISA) {
+        printf("%s: the CPU lacks the ISA, nothing to check\n", LANES_TEST);
+        return 0;
+    }
+    static const uint32_t widths[] = {52, 56, 60, 64};
+    for (uint32_t k = 3; k <= 4; ++k)
+        for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
+            sp_codec c;
+            CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, widths[i], &c) == SP_OK);
+            check_codec(&c);
+        }
+    /* just past the double lanes */
+    sp_codec k3 = oss(3, ((uint64_t)1 << 24) + 1), k4 = oss(4, ((uint64_t)3 << 15) + 1);
+    check_codec(&k3);
+    check_codec(&k4);
+    return check_report(LANES_TEST);
+}
+#else
+int main(void)
+{
+    printf("test_batch_wide_lanes: not x86, nothing to check\n");
+    return 0;
+}
+#endif
