@@ -180,19 +180,24 @@ SP_INLINE SIMD_FN unsigned weights_ordered(const vec* w, uint32_t k)
 }
 
 /*
- * A batch's weights stream in and its codes out faster than the core's prefetchers fetch them:
- * 1M vertices of K = 4 took AVX2 ~3.3-4 ns a vertex where the same code takes ~2.5 on data in
- * the cache. So each block of the first stage asks for the lines of the block ENCODE_PREFETCH
- * vertices ahead, weights and codes, the codes' lines gaining the most (their stores no longer
- * wait for each line to be read for ownership): ~1.3x for AVX2 and AVX-512 alike on that batch.
- * The addresses are formed as integers, as they may lie past the batch (a prefetch never faults).
+ * A batch streams through the lanes faster than the core's prefetchers fetch it: 1M vertices of
+ * K = 4 took AVX2 ~3.3-4 ns a vertex to encode where the same code takes ~2.5 on data in the
+ * cache, and ~3.7-4.2 to decode (wide codes) where it takes ~2.9. So each block of a chunk's
+ * first stage asks for the weight and code lines of the lanes STREAM_PREFETCH vertices ahead,
+ * every line of them (AVX-512's K = 4 block spans two lines of weights). Encode: ~1.3x for AVX2
+ * and AVX-512 alike, the output codes' lines gaining the most (their stores no longer wait for
+ * each line to be read for ownership); K = 2 pair lanes ~1.15x. Decode: wide K = 4 ~1.3x (AVX2)
+ * and ~1.2x (AVX-512), the rest ~1.1x. The addresses are formed as integers, as they may lie
+ * past the batch (a prefetch never faults).
  */
-#define ENCODE_PREFETCH 128 /* vertices ahead: 64 and 256 ran up to ~10% slower (AVX2, AVX-512) */
+#define STREAM_PREFETCH 128 /* vertices ahead: 64 and 256 ran up to ~10% slower (encode, AVX2, AVX-512) */
 
-SP_INLINE SIMD_FN void prefetch_block(const float* weights, uint32_t k, const uint64_t* codes)
+SP_INLINE SIMD_FN void prefetch_lanes(const float* weights, uint32_t k, const uint64_t* codes, uint32_t lanes)
 {
-    SP_PREFETCH((const void*)((uintptr_t)weights + ENCODE_PREFETCH * k * sizeof(float)));
-    SP_PREFETCH((const void*)((uintptr_t)codes + ENCODE_PREFETCH * sizeof(uint64_t)));
+    uintptr_t w = (uintptr_t)weights + STREAM_PREFETCH * k * sizeof(float);
+    uintptr_t c = (uintptr_t)codes + STREAM_PREFETCH * sizeof(uint64_t);
+    for (uint32_t line = 0; line < lanes * k * sizeof(float); line += 64) SP_PREFETCH((const void*)(w + line));
+    for (uint32_t line = 0; line < lanes * sizeof(uint64_t); line += 64) SP_PREFETCH((const void*)(c + line));
 }
 
 /* A block's weights (K vectors), sp_grid_load's scale and the ordered lanes (weights_ordered),
@@ -366,7 +371,7 @@ SP_INLINE SIMD_FN void encode_chunk(const sp_codec* codec, const void* constants
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
-        prefetch_block(weights + b * BLOCK * k, k, codes + b * BLOCK);
+        prefetch_lanes(weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
         ordered[b] = load_block(weights + b * BLOCK * k, k, layout, s, w[b], &scale[b]);
     }
     for (size_t b = 0; b < blocks; ++b) {
@@ -486,11 +491,16 @@ SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bo
  * only a rest = code - u(k) inside layer k's triangle (a negative rest fails s(j) <= rest, one
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
  * and then (k, row, i) is the one tuple whose index is code. */
-/* `blocks` blocks of codes into `code`, each checked against max_code: 0 where one is above it. */
-SP_INLINE SIMD_FN int load_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, vec* code)
+/* `blocks` blocks of codes into `code`, each checked against max_code: 0 where one is above it;
+ * the lines of the weights they decode to are asked for ahead (prefetch_lanes). */
+SP_INLINE SIMD_FN int load_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, const float* weights,
+                                 uint32_t k, vec* code)
 {
     code_check check = check_start(codec->max_code);
-    for (size_t b = 0; b < blocks; ++b) code[b] = load_codes(codes + b * BLOCK, &check);
+    for (size_t b = 0; b < blocks; ++b) {
+        prefetch_lanes(weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
+        code[b] = load_codes(codes + b * BLOCK, &check);
+    }
     return check_passed(&check);
 }
 
@@ -502,7 +512,7 @@ SP_INLINE SIMD_FN int decode_chunk(const sp_codec* codec, const void* constants,
     vec layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK], x[DECODE_CHUNK];
     root z[DECODE_CHUNK];
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
-    if (!load_chunk(codec, codes, blocks, rest)) return 0; /* nothing written yet */
+    if (!load_chunk(codec, codes, blocks, weights, k, rest)) return 0; /* nothing written yet */
     if (k == 4) {
         for (size_t b = 0; b < blocks; ++b) {
             x[b] = layer_argument(n, rest[b]);
@@ -650,6 +660,7 @@ SP_INLINE SIMD_FN int decode_chunk_narrow(const sp_codec* codec, const void* con
     nvec x[NARROW_CHUNK], z[NARROW_CHUNK];
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
+        prefetch_lanes(weights + b * NBLOCK * k, k, codes + b * NBLOCK, NBLOCK);
         rest[b] = load_codes32(codes + b * NBLOCK, &check);
         if (k == 4) x[b] = n_layer_start(n, rest[b], &z[b]);
     }
@@ -761,6 +772,7 @@ SP_INLINE SIMD_FN int decode_chunk_split(const sp_codec* codec, const void* cons
     unsigned missed[SPLIT_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) { /* loaded again for the rests: a smaller frame ran ~5% faster */
+        prefetch_lanes(weights + b * NBLOCK * k, k, codes + b * NBLOCK, NBLOCK);
         vec first = load_codes(codes + b * NBLOCK, &check), second = load_codes(codes + b * NBLOCK + BLOCK, &check);
         x[b] = f_from_pair(layer_argument(n, first), layer_argument(n, second));
         z[b] = n_root_start(x[b]);

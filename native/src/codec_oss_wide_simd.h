@@ -156,7 +156,7 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     vec w[ENCODE_CHUNK][SP_MAX_INFLUENCES], scale[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], ordered[ENCODE_CHUNK], any = 0; /* lanes as bits */
     for (size_t b = 0; b < blocks; ++b) {
-        prefetch_block(weights + b * BLOCK * k, k, codes + b * BLOCK);
+        prefetch_lanes(weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
         ordered[b] = load_block(weights + b * BLOCK * k, k, layout, c->scale, w[b], &scale[b]);
     }
     if (encode_fused(k))
@@ -254,8 +254,10 @@ SP_INLINE SIMD_FN void wide_pair_chunk(const sp_codec* codec, const void* consta
     wide_pair parts[ENCODE_CHUNK];
     unsigned missed[ENCODE_CHUNK], any = 0;
     (void)layout;
-    for (size_t b = 0; b < blocks; ++b)
+    for (size_t b = 0; b < blocks; ++b) {
+        prefetch_lanes(weights + b * BLOCK * 2, 2, codes + b * BLOCK, BLOCK);
         any |= missed[b] = wide_pair_start((const wide_codec*)constants, weights + b * BLOCK * 2, &parts[b]);
+    }
     for (size_t b = 0; b < blocks; ++b)
         wide_pair_finish(&parts[b], codes + b * BLOCK, significant ? significant + b * BLOCK : NULL);
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant);
@@ -375,6 +377,7 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
+        prefetch_lanes(weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
         load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
         if (k > 2) v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
         if (k == 4) {
