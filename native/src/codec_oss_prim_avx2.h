@@ -404,7 +404,6 @@ SP_INLINE SIMD_FN vec root_finish_fine(vec x, root zf)
 #define WIDE_NAME(name) sp_oss_wide_##name##_avx2
 
 typedef __m256i uvec;
-typedef __m256i umask; /* all-ones lanes */
 
 #define u_srl(a, n) _mm256_srli_epi64(a, n)
 #define u_sll(a, n) _mm256_slli_epi64(a, n)
@@ -414,7 +413,6 @@ SP_INLINE SIMD_FN void u_store(uint64_t* p, uvec a) { _mm256_storeu_si256((__m25
 SP_INLINE SIMD_FN uvec u_add(uvec a, uvec b) { return _mm256_add_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm256_sub_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm256_and_si256(a, b); }
-SP_INLINE SIMD_FN uvec u_srlv(uvec a, uvec count) { return _mm256_srlv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm256_mul_epu32(a, b); }
 SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_add(u_mul32(a, b), u_sll(u_mul32(u_srl(a, 32), b), 32)); }
 SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b)
@@ -422,15 +420,6 @@ SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b)
     uvec cross = u_add(u_mul32(u_srl(a, 32), b), u_mul32(a, u_srl(b, 32)));
     return u_add(u_mul32(a, b), u_sll(cross, 32));
 }
-SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b)
-{
-    uvec flip = u_splat((uint64_t)1 << 63);
-    return _mm256_cmpgt_epi64(_mm256_xor_si256(b, flip), _mm256_xor_si256(a, flip));
-}
-SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm256_cmpgt_epi64(b, a); }
-SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
-SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm256_blendv_epi8(b, a, m); }
-SP_INLINE SIMD_FN unsigned um_bits(umask m) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(m)); }
 SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
 {
     return u_sub(_mm256_castpd_si256(x), _mm256_castpd_si256(v_splat(0x1.8p52)));

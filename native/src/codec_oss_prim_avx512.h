@@ -301,7 +301,6 @@ SP_INLINE SIMD_FN void root_start_pair(vec a, vec b, root* first, root* second)
 SP_INLINE SIMD_FN vec root_finish_fine(vec x, root yf) { return root_finish(x, yf); }
 
 typedef __m512i uvec;
-typedef __mmask8 umask;
 
 #define u_srl(a, n) _mm512_srli_epi64(a, n)
 #define u_sll(a, n) _mm512_slli_epi64(a, n)
@@ -311,15 +310,9 @@ SP_INLINE SIMD_FN void u_store(uint64_t* p, uvec a) { _mm512_storeu_si512(p, a);
 SP_INLINE SIMD_FN uvec u_add(uvec a, uvec b) { return _mm512_add_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm512_sub_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm512_and_si512(a, b); }
-SP_INLINE SIMD_FN uvec u_srlv(uvec a, uvec count) { return _mm512_srlv_epi64(a, count); }
 SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm512_mul_epu32(a, b); }
 SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b) { return _mm512_mullo_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_mul(a, b); }
-SP_INLINE SIMD_FN umask u_lt(uvec a, uvec b) { return _mm512_cmplt_epu64_mask(a, b); }
-SP_INLINE SIMD_FN umask u_lt_signed(uvec a, uvec b) { return _mm512_cmplt_epi64_mask(a, b); }
-SP_INLINE SIMD_FN umask u_lt_small(uvec a, uvec b) { return u_lt_signed(a, b); }
-SP_INLINE SIMD_FN uvec u_select(umask m, uvec a, uvec b) { return _mm512_mask_blend_epi64(m, b, a); }
-SP_INLINE SIMD_FN unsigned um_bits(umask m) { return m; }
 SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
 {
     return u_sub(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52)));

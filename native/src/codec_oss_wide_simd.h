@@ -21,13 +21,11 @@
  *
  * The including file defines, all SP_INLINE and compiled for its ISA (SIMD_FN), on top of the
  * double-lane primitives of codec_oss_simd.h:
- *   uvec, umask        BLOCK unsigned 64-bit lanes and a lane mask
- *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates), u_srlv
+ *   uvec               BLOCK unsigned 64-bit lanes
+ *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates)
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
  *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
- *   u_lt (unsigned compare), u_lt_small (both below 2^63), u_lt_signed (signed compare),
- *   u_select(m, a, b) = m ? a : b, um_bits (lanes as bits), u_unbias (integral lanes
- *   ROUNDING_MAGIC + m as m, |m| < 2^51)
+ *   u_unbias           integral lanes ROUNDING_MAGIC + m as m, |m| < 2^51
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
  *   in [0, 2^52))
