@@ -249,6 +249,12 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
                            uint8_t* significant, sp_isa widest);
 size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                            sp_isa widest);
+/* sp_oss_decode_batch with the streaming stores' threshold as an argument (count * K * 4 bytes
+ * of weights at least stream_min_bytes: streaming stores, after a scalar head of vertices up to
+ * a 64-byte aligned output), so the tests take the streaming path on small batches; streamed
+ * (may be NULL) gets how many of the vertices done were decoded with streaming stores. */
+size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                     sp_isa widest, size_t stream_min_bytes, size_t* streamed);
 /* Whether a vector path takes this codec's encode (encode = 1) or decode (0) on this CPU with
  * the vector paths capped at `widest`. */
 int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest);
@@ -257,10 +263,10 @@ int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest);
  * 8), same contract; call only where sp_cpu_isa() has the ISA and the codec is supported. */
 size_t sp_oss_encode_avx2(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                           uint8_t* significant);
-size_t sp_oss_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+size_t sp_oss_decode_avx2(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream);
 size_t sp_oss_encode_avx512(const sp_codec* codec, const float* weights, size_t count, uint64_t* codes,
                             uint8_t* significant);
-size_t sp_oss_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights);
+size_t sp_oss_decode_avx512(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream);
 
 /* The scalar OSS encode (grid rounding, significant count, index; significant may be NULL) and
  * decode (codec_oss.c) of one vertex: what the batch loops and the vector lanes that cannot

@@ -69,18 +69,53 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
     return done;
 }
 
-size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, sp_isa widest)
+/*
+ * Decode batches whose weights take at least this many bytes store them by streaming stores
+ * (codec_oss_simd.h's prefetch_decode), as glibc's memcpy does past its non-temporal threshold:
+ * outputs that large leave the caches behind anyway, while a mesh of ~100k vertices (1.6 MB of
+ * K = 4 weights), read right after its decode, stays below and in the cache.
+ */
+#define STREAM_MIN_BYTES ((size_t)4 << 20)
+#define STREAM_LINE 64
+
+/* How many vertices precede the first one whose weights start a cache line, so that the
+ * streaming stores from there write whole lines (and AVX-512's are aligned); count if none does
+ * within a line's worth (K = 4 weights not 16-byte aligned, K = 2 ones not 8-byte aligned). */
+static size_t stream_head(const float* weights, uint32_t k, size_t count)
+{
+    for (size_t v = 0; v < count && v < STREAM_LINE / sizeof(float); ++v)
+        if (!((uintptr_t)(weights + v * k) % STREAM_LINE)) return v;
+    return count;
+}
+
+size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
+                                     sp_isa widest, size_t stream_min_bytes, size_t* streamed)
 {
     size_t done = 0;
+    if (streamed) *streamed = 0;
 #if SP_X86_SIMD
     oss_lanes lanes = oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
+    uint32_t k = codec->influences;
+    if (isa < SP_ISA_AVX2 || !count) return 0; /* no pointer arithmetic on an empty batch's null arrays */
     sp_oss_decode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
     sp_oss_decode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
-    if (isa >= SP_ISA_AVX512) done = avx512(codec, codes, count, weights);
-    if (isa >= SP_ISA_AVX2 && done < count) done += avx2(codec, codes + done, count - done, weights + done * codec->influences);
+    size_t head = count * k * sizeof(float) >= stream_min_bytes ? stream_head(weights, k, count) : count;
+    int stream = head < count;
+    if (stream) { /* the head by the scalar code, which stops at an invalid code (the caller reports it) */
+        done = sp_oss_decode_scalar(codec, codes, 0, head, weights);
+        if (done < head) return done;
+    }
+    if (isa >= SP_ISA_AVX512) done += avx512(codec, codes + done, count - done, weights + done * k, stream);
+    if (done < count) done += avx2(codec, codes + done, count - done, weights + done * k, stream);
+    if (streamed && stream) *streamed = done - head;
 #else
-    (void)codec, (void)codes, (void)count, (void)weights, (void)widest;
+    (void)codec, (void)codes, (void)count, (void)weights, (void)widest, (void)stream_min_bytes, (void)stream_head;
 #endif
     return done;
+}
+
+size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, sp_isa widest)
+{
+    return sp_oss_decode_batch_streaming(codec, codes, count, weights, widest, STREAM_MIN_BYTES, NULL);
 }

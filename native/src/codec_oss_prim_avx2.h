@@ -24,8 +24,9 @@ SP_FP_CONTRACT_OFF
 typedef __m256d vec;
 typedef __m256d mask;
 typedef __m128 root;
+/* stream: the decode's weights go by streaming stores (put4, put8; codec_oss_simd.h). */
 typedef struct simd_layout {
-    int unused;
+    int stream;
 } simd_layout;
 
 SP_INLINE SIMD_FN vec v_splat(double x) { return _mm256_set1_pd(x); }
@@ -117,7 +118,8 @@ SP_INLINE SIMD_FN nint i_div9(nint a)
 
 SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 {
-    simd_layout layout = {(int)k};
+    simd_layout layout = {0};
+    (void)k;
     return layout;
 }
 
@@ -177,16 +179,41 @@ SP_INLINE SIMD_FN unsigned load_weights_ordered(const float* w, vec* x)
     return bits & (bits >> 4) & 15u;
 }
 
+/*
+ * The weights' stores, streaming (non-temporal) ones where layout->stream: they write whole
+ * lines to memory through the write-combining buffers, with no read for ownership of each line
+ * first and without evicting the caches. Streaming stores need aligned addresses: p is 16-byte
+ * aligned there (the decode entry streams only from such a start, and every store of these
+ * primitives lies a multiple of 16 bytes past it), put8's 32-byte half-way ones go as two.
+ */
+#define STREAM_ALIGN 16
+
+SP_INLINE SIMD_FN void put4(const simd_layout* layout, float* p, __m128 v)
+{
+    if (layout->stream) _mm_stream_ps(p, v);
+    else _mm_storeu_ps(p, v);
+}
+
+SP_INLINE SIMD_FN void put8(const simd_layout* layout, float* p, __m256 v)
+{
+    if (!layout->stream) _mm256_storeu_ps(p, v);
+    else if (!((uintptr_t)p & 31)) _mm256_stream_ps(p, v);
+    else {
+        _mm_stream_ps(p, _mm256_castps256_ps128(v));
+        _mm_stream_ps(p + 4, _mm256_extractf128_ps(v, 1));
+    }
+}
+
 /* Four vertices of k floats from k component vectors: transposes by shuffles and blends. */
-SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, float* out)
+SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, const simd_layout* layout, float* out)
 {
     if (k == 4) { /* a 4x4 transpose in two registers: six shuffles, not eight, and two stores */
         __m256 even = _mm256_insertf128_ps(_mm256_castps128_ps256(w[0]), w[2], 1); /* components 0 | 2 */
         __m256 odd = _mm256_insertf128_ps(_mm256_castps128_ps256(w[1]), w[3], 1);  /* components 1 | 3 */
         /* pairs (c0, c1) of vertices 0, 1 | (c2, c3) of vertices 0, 1, then the same for 2, 3 */
         __m256d lo = _mm256_castps_pd(_mm256_unpacklo_ps(even, odd)), hi = _mm256_castps_pd(_mm256_unpackhi_ps(even, odd));
-        _mm256_storeu_ps(out, _mm256_castpd_ps(_mm256_permute4x64_pd(lo, 0xD8)));     /* vertices 0, 1 */
-        _mm256_storeu_ps(out + 8, _mm256_castpd_ps(_mm256_permute4x64_pd(hi, 0xD8))); /* vertices 2, 3 */
+        put8(layout, out, _mm256_castpd_ps(_mm256_permute4x64_pd(lo, 0xD8)));     /* vertices 0, 1 */
+        put8(layout, out + 8, _mm256_castpd_ps(_mm256_permute4x64_pd(hi, 0xD8))); /* vertices 2, 3 */
     } else if (k == 3) {
         /* Output float f holds component f % 3 of vertex f / 3. Each component is permuted once
          * so that, in each of the three output vectors, the lanes it owns hold the right vertex
@@ -195,12 +222,12 @@ SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, float* out)
         __m128 p0 = _mm_permute_ps(w[0], _MM_SHUFFLE(1, 2, 3, 0)); /* vertices 0 3 2 1 */
         __m128 p1 = _mm_permute_ps(w[1], _MM_SHUFFLE(2, 3, 0, 1)); /* 1 0 3 2 */
         __m128 p2 = _mm_permute_ps(w[2], _MM_SHUFFLE(3, 0, 1, 2)); /* 2 1 0 3 */
-        _mm_storeu_ps(out, _mm_blend_ps(_mm_blend_ps(p0, p1, 0x2), p2, 0x4));
-        _mm_storeu_ps(out + 4, _mm_blend_ps(_mm_blend_ps(p1, p2, 0x2), p0, 0x4));
-        _mm_storeu_ps(out + 8, _mm_blend_ps(_mm_blend_ps(p2, p0, 0x2), p1, 0x4));
+        put4(layout, out, _mm_blend_ps(_mm_blend_ps(p0, p1, 0x2), p2, 0x4));
+        put4(layout, out + 4, _mm_blend_ps(_mm_blend_ps(p1, p2, 0x2), p0, 0x4));
+        put4(layout, out + 8, _mm_blend_ps(_mm_blend_ps(p2, p0, 0x2), p1, 0x4));
     } else {
-        _mm_storeu_ps(out, _mm_unpacklo_ps(w[0], w[1]));
-        _mm_storeu_ps(out + 4, _mm_unpackhi_ps(w[0], w[1]));
+        put4(layout, out, _mm_unpacklo_ps(w[0], w[1]));
+        put4(layout, out + 4, _mm_unpackhi_ps(w[0], w[1]));
     }
 }
 
@@ -208,10 +235,9 @@ SP_INLINE SIMD_FN void store_floats(const __m128* w, uint32_t k, float* out)
 SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
 {
     __m128 w[SP_MAX_INFLUENCES];
-    (void)layout;
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) w[i] = _mm256_cvtpd_ps(_mm256_mul_pd(q[i], v_splat(inverse)));
-    store_floats(w, k, out);
+    store_floats(w, k, layout, out);
 }
 
 /* Codes <= max_code, compared unsigned as signed with the sign bits flipped: 64-bit lanes, or
@@ -242,28 +268,28 @@ SP_INLINE SIMD_FN nint load_codes32(const uint64_t* codes, code_check* check)
 }
 
 /* Eight vertices of k floats from k component vectors (store_floats on eight lanes). */
-SP_INLINE SIMD_FN void store_floats8(const __m256* w, uint32_t k, float* out)
+SP_INLINE SIMD_FN void store_floats8(const __m256* w, uint32_t k, const simd_layout* layout, float* out)
 {
     if (k == 4) {
         __m256 t0 = _mm256_unpacklo_ps(w[0], w[1]), t1 = _mm256_unpackhi_ps(w[0], w[1]); /* c0 c1 of v0 v1 | v4 v5 ... */
         __m256 t2 = _mm256_unpacklo_ps(w[2], w[3]), t3 = _mm256_unpackhi_ps(w[2], w[3]);
         __m256 v04 = _mm256_shuffle_ps(t0, t2, 0x44), v15 = _mm256_shuffle_ps(t0, t2, 0xEE); /* vertex 0 | 4, 1 | 5 */
         __m256 v26 = _mm256_shuffle_ps(t1, t3, 0x44), v37 = _mm256_shuffle_ps(t1, t3, 0xEE);
-        _mm256_storeu_ps(out, _mm256_permute2f128_ps(v04, v15, 0x20));
-        _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(v26, v37, 0x20));
-        _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(v04, v15, 0x31));
-        _mm256_storeu_ps(out + 24, _mm256_permute2f128_ps(v26, v37, 0x31));
+        put8(layout, out, _mm256_permute2f128_ps(v04, v15, 0x20));
+        put8(layout, out + 8, _mm256_permute2f128_ps(v26, v37, 0x20));
+        put8(layout, out + 16, _mm256_permute2f128_ps(v04, v15, 0x31));
+        put8(layout, out + 24, _mm256_permute2f128_ps(v26, v37, 0x31));
     } else if (k == 3) { /* as store_floats: component c owns lanes f = c (mod 3) of the three outputs */
         __m256 p0 = _mm256_permutevar8x32_ps(w[0], _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
         __m256 p1 = _mm256_permutevar8x32_ps(w[1], _mm256_setr_epi32(5, 0, 3, 6, 1, 4, 7, 2));
         __m256 p2 = _mm256_permutevar8x32_ps(w[2], _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
-        _mm256_storeu_ps(out, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x92), p2, 0x24));
-        _mm256_storeu_ps(out + 8, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x24), p2, 0x49));
-        _mm256_storeu_ps(out + 16, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x49), p2, 0x92));
+        put8(layout, out, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x92), p2, 0x24));
+        put8(layout, out + 8, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x24), p2, 0x49));
+        put8(layout, out + 16, _mm256_blend_ps(_mm256_blend_ps(p0, p1, 0x49), p2, 0x92));
     } else {
         __m256 lo = _mm256_unpacklo_ps(w[0], w[1]), hi = _mm256_unpackhi_ps(w[0], w[1]); /* v0 v1 | v4 v5, v2 v3 | v6 v7 */
-        _mm256_storeu_ps(out, _mm256_permute2f128_ps(lo, hi, 0x20));
-        _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+        put8(layout, out, _mm256_permute2f128_ps(lo, hi, 0x20));
+        put8(layout, out + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
     }
 }
 
@@ -282,7 +308,7 @@ SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t 
     for (uint32_t i = 0; i < 3; ++i)
         w[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(_mm256_mul_pd(first[i], v_splat(inverse)))),
                                     _mm256_cvtpd_ps(_mm256_mul_pd(second[i], v_splat(inverse))), 1);
-    store_floats8(w, 3, out);
+    store_floats8(w, 3, layout, out);
 }
 
 /*
@@ -296,13 +322,12 @@ SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t 
 SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
 {
     __m256 w[SP_MAX_INFLUENCES], s = _mm256_set1_ps((float)scale), r = _mm256_set1_ps(1.0f / (float)scale);
-    (void)layout;
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
         __m256 x = _mm256_cvtepi32_ps(q[i]), y = _mm256_mul_ps(x, r);
         w[i] = _mm256_fmadd_ps(_mm256_fnmadd_ps(y, s, x), r, y);
     }
-    store_floats8(w, k, out);
+    store_floats8(w, k, layout, out);
 }
 
 /* u64 < 2^52 <-> double by placing it in the mantissa of 2^52 (AVX2 has no 64-bit conversion);
@@ -461,10 +486,9 @@ SP_INLINE SIMD_FN vec v_from_u_rounded(uvec a)
  * loop). */
 SP_INLINE SIMD_FN void store_pairs(vec q0, vec q1, double inverse, const simd_layout* layout, float* out)
 {
-    (void)layout;
     __m128 first = _mm256_cvtpd_ps(v_mul(q0, v_splat(inverse))), second = _mm256_cvtpd_ps(v_mul(q1, v_splat(inverse)));
-    _mm_storeu_ps(out, _mm_unpacklo_ps(first, second));
-    _mm_storeu_ps(out + 4, _mm_unpackhi_ps(first, second));
+    put4(layout, out, _mm_unpacklo_ps(first, second));
+    put4(layout, out + 4, _mm_unpackhi_ps(first, second));
 }
 
 /* K = 2 encode past 2^50 grids in double lanes (codec_oss_wide_simd.h's wide_pair_start):
@@ -489,7 +513,6 @@ SP_INLINE SIMD_FN uvec u_bits(vec x) { return _mm256_castpd_si256(x); } /* the b
  * another, blended; then the last vertex and a half the same way. */
 SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_layout* layout, float* out)
 {
-    (void)layout;
     __m128 w0 = _mm256_cvtpd_ps(v_mul(q[0], v_splat(inverse))), w1 = _mm256_cvtpd_ps(v_mul(q[1], v_splat(inverse)));
     __m128 w2 = _mm256_cvtpd_ps(v_mul(q[2], v_splat(inverse)));
     __m256 pairs = _mm256_insertf128_ps(_mm256_castps128_ps256(w0), w1, 1), thirds = _mm256_castps128_ps256(w2);
@@ -497,8 +520,8 @@ SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_la
                                   _mm256_permutevar8x32_ps(thirds, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 0, 0)), 0x24);
     __m256 tail = _mm256_blend_ps(_mm256_permutevar8x32_ps(pairs, _mm256_setr_epi32(0, 3, 7, 0, 0, 0, 0, 0)),
                                   _mm256_permutevar8x32_ps(thirds, _mm256_setr_epi32(2, 0, 0, 3, 0, 0, 0, 0)), 0x09);
-    _mm256_storeu_ps(out, head);
-    _mm_storeu_ps(out + 8, _mm256_castps256_ps128(tail));
+    put8(layout, out, head);
+    put4(layout, out + 8, _mm256_castps256_ps128(tail));
 }
 #endif
 #endif

@@ -23,9 +23,11 @@ SP_FP_CONTRACT_OFF /* avx512f implies fma */
 typedef __m512d vec;
 typedef __mmask8 mask;
 typedef __m256 root;
-/* Permute indices between 8 vertices of k floats and component pairs (see soa_index). */
+/* Permute indices between 8 vertices of k floats and component pairs (see soa_index); stream:
+ * the decode's weights go by streaming stores (put16, put8; codec_oss_simd.h). */
 typedef struct simd_layout {
     __m512i soa[2], aos[2];
+    int stream;
 } simd_layout;
 
 SP_INLINE SIMD_FN vec v_splat(double x) { return _mm512_set1_pd(x); }
@@ -139,7 +141,7 @@ SP_INLINE SIMD_FN __m512i aos_index(uint32_t k, uint32_t half)
 
 SP_INLINE SIMD_FN simd_layout layout_for(uint32_t k)
 {
-    simd_layout layout = {{soa_index(k, 0), soa_index(k, 1)}, {aos_index(k, 0), aos_index(k, 1)}};
+    simd_layout layout = {{soa_index(k, 0), soa_index(k, 1)}, {aos_index(k, 0), aos_index(k, 1)}, 0};
     return layout;
 }
 
@@ -157,6 +159,38 @@ SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layou
     }
 }
 
+/*
+ * The weights' stores, streaming (non-temporal) ones where layout->stream (see put8 in
+ * codec_oss_prim_avx2.h). p is 32-byte aligned there (the decode entry streams only from such a
+ * start, and every store here lies a multiple of 32 bytes past it: K = 3's blocks of 96), and
+ * put16's stores half-way into a line go as two of 32 bytes.
+ */
+#define STREAM_ALIGN 32
+
+SP_INLINE SIMD_FN void put8(const simd_layout* layout, float* p, __m256 v)
+{
+    if (layout->stream) _mm256_stream_ps(p, v);
+    else _mm256_storeu_ps(p, v);
+}
+
+SP_INLINE SIMD_FN void put16(const simd_layout* layout, float* p, __m512 v)
+{
+    if (!layout->stream) _mm512_storeu_ps(p, v);
+    else if (!((uintptr_t)p & 63)) _mm512_stream_ps(p, v);
+    else {
+        _mm256_stream_ps(p, _mm512_castps512_ps256(v));
+        _mm256_stream_ps(p + 8, _mm512_extractf32x8_ps(v, 1));
+    }
+}
+
+/* The floats of eight vertices, 2k of them, from the two component pairs (a = 0, 1 | 2, 3). */
+SP_INLINE SIMD_FN void store_vertices8(const __m512* pair, uint32_t k, const simd_layout* layout, float* out)
+{
+    put16(layout, out, _mm512_permutex2var_ps(pair[0], layout->aos[0], pair[1]));
+    if (k == 4) put16(layout, out + 16, _mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1]));
+    if (k == 3) put8(layout, out + 16, _mm512_castps512_ps256(_mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1])));
+}
+
 /* (float)(q * (1/s)) per component, as sp_grid_to_weights does, stored as eight vertices. */
 SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, const simd_layout* layout, float* out)
 {
@@ -166,10 +200,7 @@ SP_INLINE SIMD_FN void store_weights(const vec* q, uint32_t k, double inverse, c
         __m256 w = _mm512_cvtpd_ps(_mm512_mul_pd(q[i], v_splat(inverse)));
         pair[i / 2] = i % 2 ? _mm512_insertf32x8(pair[i / 2], w, 1) : _mm512_castps256_ps512(w);
     }
-    _mm512_storeu_ps(out, _mm512_permutex2var_ps(pair[0], layout->aos[0], pair[1]));
-    if (k > 2)
-        _mm512_mask_storeu_ps(out + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
-                              _mm512_permutex2var_ps(pair[0], layout->aos[1], pair[1]));
+    store_vertices8(pair, k, layout, out);
 }
 
 /* Codes <= max_code: the largest code seen, compared once. */
@@ -222,13 +253,7 @@ SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, 
     pairs[0][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0x44) : pairs[0][0];
     pairs[1][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0xEE) : pairs[1][0];
     SP_UNROLL
-    for (uint32_t half = 0; half < 2; ++half) {
-        float* at = out + half * BLOCK * k;
-        _mm512_storeu_ps(at, _mm512_permutex2var_ps(pairs[half][0], layout->aos[0], pairs[half][1]));
-        if (k > 2)
-            _mm512_mask_storeu_ps(at + 16, (__mmask16)(k == 4 ? 0xFFFF : 0x00FF),
-                                  _mm512_permutex2var_ps(pairs[half][0], layout->aos[1], pairs[half][1]));
-    }
+    for (uint32_t half = 0; half < 2; ++half) store_vertices8(pairs[half], k, layout, out + half * BLOCK * k);
 }
 
 SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)

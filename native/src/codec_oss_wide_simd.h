@@ -375,7 +375,7 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
-        prefetch_lanes(weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
+        prefetch_decode(layout, weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
         load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
         if (k > 2) v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
         if (k == 4) {
@@ -421,14 +421,17 @@ DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk, BLOCK, DECODE_CHUNK, 1)
 
 /* The chunks to the end or to the block holding an invalid code. */
 SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
-                                            size_t count, float* weights, uint32_t k)
+                                            size_t count, float* weights, int stream, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    layout.stream = stream_from(weights, stream);
+    size_t v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    if (layout.stream) _mm_sfence(); /* as decode_blocks */
+    return v;
 }
 
-SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights)
+SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream)
 {
     wide_codec c = wide_codec_for(codec);
-    RETURN_FOR_EACH_K(codec, wide_decode_blocks, codec, &c, codes, count, weights)
+    RETURN_FOR_EACH_K(codec, wide_decode_blocks, codec, &c, codes, count, weights, stream)
 }
