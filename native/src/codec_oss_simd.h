@@ -831,17 +831,26 @@ DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0
 /* The narrow chunks (narrow codecs) or the split ones (K = 4 up to SPLIT_MAX_N4) up to the
  * first one holding an invalid code, then the double lanes from there to the end or to the
  * block holding it. */
-SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
-                                       size_t count, float* weights, int stream, uint32_t k)
+SP_INLINE SIMD_FN size_t decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                      size_t count, float* weights, int stream, uint32_t k)
 {
     simd_layout layout = layout_for(k);
-    layout.stream = stream_from(weights, stream);
+    layout.stream = stream;
     size_t v = 0;
     if (narrow_decode(codec, k)) v = decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout);
     else if (split_decode(codec, k)) v = decode_walk_split(codec, constants, codes, 0, count, weights, k, &layout);
     v = decode_walk(codec, constants, codes, v, count, weights, k, &layout);
     if (layout.stream) _mm_sfence(); /* the streamed lines ordered before whatever the caller publishes next */
     return v;
+}
+
+/* decode_lanes with stream a constant in each call: the normal stores' code has no tests of it
+ * (which cost ~1 instruction a vertex). */
+SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                       size_t count, float* weights, int stream, uint32_t k)
+{
+    if (stream_from(weights, stream)) return decode_lanes(codec, constants, codes, count, weights, 1, k);
+    return decode_lanes(codec, constants, codes, count, weights, 0, k);
 }
 
 SIMD_FN size_t SIMD_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream)

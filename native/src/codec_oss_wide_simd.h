@@ -419,15 +419,23 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
 
 DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk, BLOCK, DECODE_CHUNK, 1)
 
-/* The chunks to the end or to the block holding an invalid code. */
+/* The chunks to the end or to the block holding an invalid code; stream a constant in each
+ * call, as in decode_blocks. */
+SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                           size_t count, float* weights, int stream, uint32_t k)
+{
+    simd_layout layout = layout_for(k);
+    layout.stream = stream;
+    size_t v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    if (stream) _mm_sfence(); /* as decode_lanes */
+    return v;
+}
+
 SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                             size_t count, float* weights, int stream, uint32_t k)
 {
-    simd_layout layout = layout_for(k);
-    layout.stream = stream_from(weights, stream);
-    size_t v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
-    if (layout.stream) _mm_sfence(); /* as decode_blocks */
-    return v;
+    if (stream_from(weights, stream)) return wide_decode_lanes(codec, constants, codes, count, weights, 1, k);
+    return wide_decode_lanes(codec, constants, codes, count, weights, 0, k);
 }
 
 SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream)
