@@ -844,13 +844,17 @@ SP_INLINE SIMD_FN size_t decode_lanes(const sp_codec* codec, const void* constan
     return v;
 }
 
-/* decode_lanes with stream a constant in each call: the normal stores' code has no tests of it
- * (which cost ~1 instruction a vertex). */
+/* return f(codec, constants, codes, count, weights, stream, k) with stream a constant in each
+ * call (stream_from's answer): the normal stores' code has no tests of it (which cost ~1
+ * instruction a vertex). */
+#define RETURN_STREAMING_OR_NOT(f, codec, constants, codes, count, weights, stream, k) \
+    if (stream_from(weights, stream)) return f(codec, constants, codes, count, weights, 1, k); \
+    return f(codec, constants, codes, count, weights, 0, k);
+
 SP_INLINE SIMD_FN size_t decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                        size_t count, float* weights, int stream, uint32_t k)
 {
-    if (stream_from(weights, stream)) return decode_lanes(codec, constants, codes, count, weights, 1, k);
-    return decode_lanes(codec, constants, codes, count, weights, 0, k);
+    RETURN_STREAMING_OR_NOT(decode_lanes, codec, constants, codes, count, weights, stream, k)
 }
 
 SIMD_FN size_t SIMD_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream)

@@ -434,8 +434,7 @@ SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* co
 SP_INLINE SIMD_FN size_t wide_decode_blocks(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                             size_t count, float* weights, int stream, uint32_t k)
 {
-    if (stream_from(weights, stream)) return wide_decode_lanes(codec, constants, codes, count, weights, 1, k);
-    return wide_decode_lanes(codec, constants, codes, count, weights, 0, k);
+    RETURN_STREAMING_OR_NOT(wide_decode_lanes, codec, constants, codes, count, weights, stream, k)
 }
 
 SIMD_FN size_t WIDE_NAME(decode)(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights, int stream)

@@ -19,30 +19,24 @@
 
 /* The streaming stores, counted in bytes (the intrinsics the primitives call, replaced below). */
 static size_t streamed_bytes = 0;
-SP_TARGET("avx2") static void counted_stream256(float* p, __m256 v)
-{
-    streamed_bytes += sizeof v;
-    _mm256_stream_ps(p, v);
-}
+#define COUNTED_STREAM(name, vector, isa, store) \
+    SP_TARGET(isa) static void name(float* p, vector v) \
+    { \
+        streamed_bytes += sizeof v; \
+        store(p, v); \
+    }
+COUNTED_STREAM(counted_stream256, __m256, "avx2", _mm256_stream_ps)
 #define _mm256_stream_ps(p, v) counted_stream256(p, v)
 
 #include "../../native/src/codec_oss_wide.h"
 #if LANES_AVX512
-SP_TARGET("avx512f") static void counted_stream512(float* p, __m512 v)
-{
-    streamed_bytes += sizeof v;
-    _mm512_stream_ps(p, v);
-}
+COUNTED_STREAM(counted_stream512, __m512, "avx512f", _mm512_stream_ps)
 #define _mm512_stream_ps(p, v) counted_stream512(p, v)
 #include "../../native/src/codec_oss_prim_avx512.h"
 #define LANES_ISA SP_ISA_AVX512
 #define LANES_TEST "test_batch_stream_lanes_avx512"
 #else
-SP_TARGET("avx2") static void counted_stream128(float* p, __m128 v)
-{
-    streamed_bytes += sizeof v;
-    _mm_stream_ps(p, v);
-}
+COUNTED_STREAM(counted_stream128, __m128, "avx2", _mm_stream_ps)
 #define _mm_stream_ps(p, v) counted_stream128(p, v)
 #include "../../native/src/codec_oss_prim_avx2.h"
 #define LANES_ISA SP_ISA_AVX2
