@@ -250,8 +250,8 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                            sp_isa widest);
 /* sp_oss_decode_batch with the streaming stores' threshold as an argument (count * K * 4 bytes
- * of weights at least stream_min_bytes: streaming stores, after a scalar head of vertices up to
- * a 64-byte aligned output), so the tests take the streaming path on small batches; streamed
+ * of weights at least stream_min_bytes, lanes where it pays: streaming stores, after a scalar
+ * head of vertices up to a 64-byte aligned output), so the tests take the streaming path on small batches; streamed
  * (may be NULL) gets how many of the vertices done were decoded with streaming stores. */
 size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                                      sp_isa widest, size_t stream_min_bytes, size_t* streamed);
