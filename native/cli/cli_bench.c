@@ -284,8 +284,7 @@ int skinpack_cmd_bench(int argc, char** argv)
                 bench_rate enc, dec;
                 if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
                 codec_rates(&o, &b, &codec, &enc, &dec);
-                int vector_encode = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, 1, isa);
-                int vector_decode = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, 0, isa);
+                int vector = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, isa);
                 if (o.json)
                     printf("%s{\"method\": \"%s\", \"influences\": %u, \"budget\": %u, \"bits\": %u, "
                            "\"encode_vector\": %s, \"decode_vector\": %s, "
@@ -293,13 +292,13 @@ int skinpack_cmd_bench(int argc, char** argv)
                            "\"encode_ratio\": %.3f, \"decode_ratio\": %.3f, \"encode_best_ratio\": %.3f, "
                            "\"decode_best_ratio\": %.3f}",
                            first ? "" : ", ", sp_method_name((sp_method)m), k, budgets[i], codec.bits,
-                           vector_encode ? "true" : "false", vector_decode ? "true" : "false", enc.per_s, dec.per_s,
+                           vector ? "true" : "false", vector ? "true" : "false", enc.per_s, dec.per_s,
                            enc.ratio, dec.ratio, enc.best_ratio, dec.best_ratio);
                 else
                     printf("%-6s %2u %4u  %10.1f %6.3fx %6.3fx  %10.1f %6.3fx %6.3fx%s\n", sp_method_name((sp_method)m), k,
                            codec.bits, enc.per_s / 1e6, enc.ratio, enc.best_ratio, dec.per_s / 1e6, dec.ratio,
                            dec.best_ratio,
-                           vector_encode && vector_decode ? "" : (vector_decode ? "  (scalar encode)" : "  (scalar)"));
+                           vector ? "" : "  (scalar)");
                 first = 0;
             }
     }

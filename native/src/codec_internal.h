@@ -255,9 +255,9 @@ size_t sp_oss_decode_batch(const sp_codec* codec, const uint64_t* codes, size_t 
  * (may be NULL) gets how many of the vertices done were decoded with streaming stores. */
 size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* codes, size_t count, float* weights,
                                      sp_isa widest, size_t stream_min_bytes, size_t* streamed);
-/* Whether a vector path takes this codec's encode (encode = 1) or decode (0) on this CPU with
- * the vector paths capped at `widest`. */
-int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest);
+/* Whether a vector path takes this codec (its encode and its decode alike) on this CPU with the
+ * vector paths capped at `widest`. */
+int sp_oss_batch_supported(const sp_codec* codec, sp_isa widest);
 
 /* The per-ISA paths (codec_oss_batch_avx2.c: blocks of 4; codec_oss_batch_avx512.c: blocks of
  * 8), same contract; call only where sp_cpu_isa() has the ISA and the codec is supported. */

@@ -41,9 +41,9 @@ static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
     return cpu < widest ? cpu : widest;
 }
 
-int sp_oss_batch_supported(const sp_codec* codec, int encode, sp_isa widest)
+/* Each ISA takes both ways, K = 2 encode past 2^50 grids too (codec_oss_wide_simd.h). */
+int sp_oss_batch_supported(const sp_codec* codec, sp_isa widest)
 {
-    (void)encode; /* each ISA takes both ways, K = 2 encode past 2^50 grids too (codec_oss_wide_simd.h) */
     return batch_isa(oss_lanes_for(codec), widest) > SP_ISA_SCALAR;
 }
 

@@ -205,7 +205,7 @@ SP_INLINE SIMD_FN void prefetch_lanes(const float* weights, uint32_t k, const ui
 }
 
 /*
- * Decode batches of at least SP_STREAM_MIN_BYTES of weights (codec_oss_batch.c) store them by
+ * Decode batches of at least STREAM_MIN_BYTES of weights (codec_oss_batch.c) store them by
  * streaming stores (layout->stream: the primitives' put8 and the like), as glibc's memcpy does
  * past its non-temporal threshold: each line goes to memory once, not read for ownership first
  * and then written back, and the caches keep what they held. 1M K = 4 vertices from cold memory
@@ -519,7 +519,7 @@ SP_INLINE SIMD_FN unsigned decoded_block(double n, uint32_t k, vec layer, vec bo
  * past the triangle fails rest < s(j + 1) for every row, row j >= rows has s(j + 1) <= s(j)),
  * and then (k, row, i) is the one tuple whose index is code. */
 /* `blocks` blocks of codes into `code`, each checked against max_code: 0 where one is above it;
- * the lines of the weights they decode to are asked for ahead (prefetch_lanes). */
+ * the lines of the codes (and of the weights they decode to, unless streamed) asked for ahead. */
 SP_INLINE SIMD_FN int load_chunk(const sp_codec* codec, const uint64_t* codes, size_t blocks, const float* weights,
                                  uint32_t k, const simd_layout* layout, vec* code)
 {
