@@ -370,6 +370,52 @@ static int bench_weight_set(const char* name, const meshlet_input* in, const for
     return n;
 }
 
+/* The most triangles per meshlet at which the lower bound (64 vertices, at most that many
+ * triangles in every meshlet) still exceeds target, or 0 if none does (the bound is
+ * non-increasing in the triangle limit: each joint's ceil(T_j / limit) is, and so are the
+ * forced splits and the influence-count terms, so a binary search finds it). A split reaches
+ * target only with a meshlet of more triangles than this. */
+static uint32_t fill_needed(const char* name, const meshlet_input* in, uint32_t max_triangles, size_t target,
+                            size_t* bound_there)
+{
+    uint32_t lo = 0, hi = max_triangles; /* the answer lies in [lo, hi] */
+    *bound_there = 0;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1) / 2;
+        joint_bound b;
+        if (!joint_bound_compute(in, MAX_VERTICES, mid, &b))
+            die(name, "joint bound: out of memory");
+        if (b.palette_sum > target) {
+            lo = mid;
+            *bound_there = b.palette_sum;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    return lo;
+}
+
+/* Per weight set: how full meshlets must be for 0.90x of mo 1.3's palette entries (issue 15). */
+static void print_fill_needed(FILE* details, const char* name, const meshlet_input* in, uint32_t max_triangles,
+                              const row* mo, const row* ours, const char* weights)
+{
+    size_t target = mo->palette_entries * 9 / 10, bound = 0;
+    uint32_t fill = fill_needed(name, in, max_triangles, target, &bound);
+    if (fill == max_triangles) {
+        fprintf(details, "0.90x of mo 1.3's palette entries (%zu), %s weights: out of reach, below the bound above.\n\n",
+                target, weights);
+        return;
+    }
+    fprintf(details, "0.90x of mo 1.3's palette entries (%zu), %s weights: ", target, weights);
+    if (fill == 0)
+        fprintf(details, "the bound allows it at any fill");
+    else
+        fprintf(details, "needs a meshlet of more than %u triangles (if every meshlet holds at most %u, the bound "
+                         "is %zu)", fill, fill, bound);
+    fprintf(details, "; mo 1.3 holds %.1f triangles per meshlet, ours (cap 32) %.1f.\n\n",
+            (double)(in->index_count / 3) / mo->meshlets, (double)(in->index_count / 3) / ours->meshlets);
+}
+
 /* One mesh at one limit pair: the detail table into details, one summary line per weight set. */
 static void bench_mesh(const bench_args* args, const char* name, const char* path, const mesh_data* mesh,
                        uint32_t max_triangles, FILE* summary[WEIGHT_SETS], FILE* details)
@@ -407,6 +453,9 @@ static void bench_mesh(const bench_args* args, const char* name, const char* pat
                          "(by joint %zu + forced splits %zu; by influence count %zu).\n\n",
                 weight_set_names[w], bounds[w].palette_sum, bounds[w].by_joint, bounds[w].forced_splits,
                 bounds[w].by_influence_count);
+    for (int w = 0; w < WEIGHT_SETS; ++w)
+        print_fill_needed(details, name, &sets[w], max_triangles, &rows[w][0], &rows[w][n[w] - 1],
+                          weight_set_names[w]);
     fprintf(details, "| weights | builder | meshlets | ÷ mo 1.3 | palette entries | ÷ mo 1.3 | joint floor | max joints "
                      "| meshlets over 16 | over 32 | local tuple bits/vertex | ms | time ÷ mo 1.3 |\n"
                      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
