@@ -59,7 +59,8 @@ static size_t decode_counted(const sp_codec* c, const uint64_t* codes, size_t co
     float ref[SP_MAX_INFLUENCES];
     redone = 0;
     size_t done = counted_wide_decode(c, codes, count, w, 0);
-    CHECK_MSG(done == count / BLOCK * BLOCK, "%s K=%u N=%llu: %zu of %zu done", what, k, (unsigned long long)c->n, done, count);
+    size_t lanes = k == 4 ? NBLOCK : BLOCK; /* K = 4 in pairs of blocks */
+    CHECK_MSG(done == count / lanes * lanes, "%s K=%u N=%llu: %zu of %zu done", what, k, (unsigned long long)c->n, done, count);
     for (size_t v = 0, failures = 0; v < done && failures < 5; ++v) {
         sp_decode_weights(c, codes[v], ref);
         int same = memcmp(w + v * k, ref, k * sizeof(float)) == 0;
