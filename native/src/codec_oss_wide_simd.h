@@ -348,9 +348,9 @@ SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, vec high, vec low
  * exact. Otherwise the first step that rounds leaves a magnitude past 2^53 - 2^37, and rounding
  * is monotone: x ends past 2^52.9 with the exact value's sign, and so does the rest past 2^49,
  * outside every layer (wide_layer_outside). */
-SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, vec k)
+SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, vec k, vec apex)
 {
-    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
+    vec slope = v_sub(v_splat(-(4 * c->n + 8)), apex); /* 4k - 6N - 9 from apex = 2N + 1 - 4k: an add, not an FMA */
     vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6)); /* c */
     vec product = v_mul(inner, k), error = v_fmsub(inner, k, product);
     vec difference = v_sub(v_fmsub(high, v_splat(9 * 0x1p32), product), error);
@@ -366,6 +366,16 @@ SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, v
 SP_INLINE SIMD_FN unsigned wide_layer_outside(vec w, vec mirrored)
 {
     return ~m_bits(m_and(m_ge(w, v_zero()), m_gt(mirrored, v_zero()))) & ((1u << BLOCK) - 1);
+}
+
+/* K = 4: ROUNDING_MAGIC + the row estimate of row_from_mirrored for a rest in the layer, but
+ * its floor the nearest integer to estimate - 1/2 (a tie, an estimate exactly an integer, may go
+ * one row lower), and no clamp to row 0: a row j or j - 1 where row_from_mirrored gives j, whose
+ * offset stays below three rows' lengths. */
+SP_INLINE SIMD_FN vec wide_biased_row(vec apex, vec mirrored)
+{
+    vec estimate = v_fmadd(v_sub(apex, v_sqrt(mirrored)), v_splat(1.0 / 3.0), v_splat(-0.5));
+    return v_add(estimate, v_splat(ROUNDING_MAGIC));
 }
 
 /*
@@ -417,15 +427,18 @@ SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* cons
     if (!wide_layer_start(codec, c, codes, blocks, weights, layout, high, low, x, z)) return 0; /* nothing written yet */
     for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
     for (size_t b = 0; b < blocks; ++b) {
-        biased[b] = wide_biased_rest(c, high[b], low[b], layer[b]);
-        vec w = v_sub(biased[b], v_splat(ROUNDING_MAGIC)), apex = v_fnmadd(layer[b], v_splat(4.0), v_splat(2 * c->n + 1));
+        vec apex = v_fnmadd(layer[b], v_splat(4.0), v_splat(2 * c->n + 1));
+        biased[b] = wide_biased_rest(c, high[b], low[b], layer[b], apex);
+        vec w = v_sub(biased[b], v_splat(ROUNDING_MAGIC));
         vec mirrored = row_mirrored(apex, w);
         outside[b] = wide_layer_outside(w, mirrored);
-        row[b] = row_from_mirrored(apex, mirrored);
+        row[b] = wide_biased_row(apex, mirrored);
     }
     for (size_t p = 0; p < pairs; ++p) {
         nint q[SP_MAX_INFLUENCES], last;
-        nint layers = i_from_pair(layer[2 * p], layer[2 * p + 1]), j = i_from_pair(row[2 * p], row[2 * p + 1]);
+        vec magic = v_splat(ROUNDING_MAGIC);
+        nint layers = i_low_pair(v_add(layer[2 * p], magic), v_add(layer[2 * p + 1], magic));
+        nint j = i_low_pair(row[2 * p], row[2 * p + 1]);
         nint bottom = i_sub(i_splat((int32_t)c->n), i_add(layers, layers));
         nint i = n_row_offset(bottom, j, i_low_pair(biased[2 * p], biased[2 * p + 1]), &last);
         any |= missed[p] = n_outside(i, last) | outside[2 * p] | outside[2 * p + 1] << BLOCK;
