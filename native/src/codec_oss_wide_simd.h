@@ -415,14 +415,16 @@ SP_INLINE SIMD_FN int wide_layer_start(const sp_codec* codec, const wide_codec* 
  * finish or the row's square root into a neighbouring stage ran 10-15% slower); the rows in
  * 32-bit lanes and the weights. Then the scalar redo of the lanes it missed; nothing written
  * where a code is above max_code (returns 0); constants: the wide_codec. */
+#define WIDE_CHUNK4 (2 * DECODE_CHUNK) /* blocks: in cache ~1.04x as fast as DECODE_CHUNK (AVX2), twice as many 1.01x more */
+
 SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                          size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
 {
     const wide_codec* c = (const wide_codec*)constants;
-    vec x[DECODE_CHUNK], layer[DECODE_CHUNK], biased[DECODE_CHUNK], row[DECODE_CHUNK];
-    vec high[DECODE_CHUNK], low[DECODE_CHUNK]; /* the codes' 32-bit halves */
-    root z[DECODE_CHUNK];
-    unsigned outside[DECODE_CHUNK], missed[DECODE_CHUNK / 2], any = 0; /* lanes as bits */
+    vec x[WIDE_CHUNK4], layer[WIDE_CHUNK4], biased[WIDE_CHUNK4], row[WIDE_CHUNK4];
+    vec high[WIDE_CHUNK4], low[WIDE_CHUNK4]; /* the codes' 32-bit halves */
+    root z[WIDE_CHUNK4];
+    unsigned outside[WIDE_CHUNK4], missed[WIDE_CHUNK4 / 2], any = 0; /* lanes as bits */
     size_t blocks = 2 * pairs;
     if (!wide_layer_start(codec, c, codes, blocks, weights, layout, high, low, x, z)) return 0; /* nothing written yet */
     for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
@@ -449,7 +451,7 @@ SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* cons
     return 1;
 }
 
-DEFINE_DECODE_WALK(wide_decode_walk4, wide_decode_chunk4, NBLOCK, DECODE_CHUNK / 2, 0)
+DEFINE_DECODE_WALK(wide_decode_walk4, wide_decode_chunk4, NBLOCK, WIDE_CHUNK4 / 2, 0)
 
 /* sp_oss_unpack and sp_grid_to_weights for K = 2, 3 on `blocks` blocks of codes, in stages (K = 3:
  * the code check and the row estimate, the rest), then the scalar redo of the lanes it missed;
