@@ -347,14 +347,17 @@ SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, vec high, vec low
  * so exact wherever x is (|e| <= 2^16, 9 low + 2 < 2^37): a rest in the layer (below 2^44) is
  * exact. Otherwise the first step that rounds leaves a magnitude past 2^53 - 2^37, and rounding
  * is monotone: x ends past 2^52.9 with the exact value's sign, and so does the rest past 2^49,
- * outside every layer (wide_layer_outside). */
-SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, vec k, vec apex)
+ * outside every layer (wide_layer_outside). apex = 2N + 1 - 4k (the caller's); with `whole`, low
+ * is the code itself (below 2^52) and high unused. */
+SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, vec k, vec apex, int whole)
 {
     vec slope = v_sub(v_splat(-(4 * c->n + 8)), apex); /* 4k - 6N - 9 from apex = 2N + 1 - 4k: an add, not an FMA */
     vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6)); /* c */
-    vec product = v_mul(inner, k), error = v_fmsub(inner, k, product);
-    vec difference = v_sub(v_fmsub(high, v_splat(9 * 0x1p32), product), error);
-    vec x = v_add(difference, v_fmadd(low, v_splat(9.0), v_splat(2.0)));
+    vec product = v_mul(inner, k), error = v_fmsub(inner, k, product), x;
+    if (whole) /* low is the code: ((9 code - p) - e) + 2, 9 code exact in the FMA, the same steps' exactness */
+        x = v_add(v_sub(v_fmsub(low, v_splat(9.0), product), error), v_splat(2.0));
+    else
+        x = v_add(v_sub(v_fmsub(high, v_splat(9 * 0x1p32), product), error), v_fmadd(low, v_splat(9.0), v_splat(2.0)));
     return v_fmadd(x, v_splat(1.0 / 9.0), v_splat(ROUNDING_MAGIC));
 }
 
@@ -393,44 +396,56 @@ SP_INLINE SIMD_FN vec wide_biased_row(vec apex, vec mirrored)
  * row check accepts proves (k, j, i).
  */
 /* The first stage of K = 4's wide decode over `blocks` blocks: each block's codes checked, their
- * halves (v_halves), the layer root's argument and its float start (root_start_pair: ~5% faster
- * on AVX2 than one by one); returns whether every code passed. */
+ * halves (v_halves), or with `whole` (codes below WIDE_WHOLE_CODES) the codes themselves in low,
+ * the layer root's argument and its float start (root_start_pair: ~5% faster on AVX2 than one by
+ * one); returns whether every code passed. The whole codes' argument (root_high - 144 code) +
+ * root_low is exact where small as wide_argument's is (a difference of multiples of 16 below
+ * 2^57, then an integer below 2^20 added), rounded at most twice where large. */
 SP_INLINE SIMD_FN int wide_layer_start(const sp_codec* codec, const wide_codec* c, const uint64_t* codes, size_t blocks,
-                                       float* weights, const simd_layout* layout, vec* high, vec* low, vec* x, root* z)
+                                       float* weights, const simd_layout* layout, int whole, vec* high, vec* low, vec* x,
+                                       root* z)
 {
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
         prefetch_decode(layout, weights + b * BLOCK * 4, 4, codes + b * BLOCK, BLOCK);
-        load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
-        v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
-        x[b] = wide_layer_argument(c, high[b], low[b]);
+        vec code = load_codes(codes + b * BLOCK, &check); /* exact below 2^52 */
+        if (whole) {
+            low[b] = code;
+            x[b] = v_add(v_fnmadd(code, v_splat(144.0), v_splat(c->root_high)), v_splat(c->root_low));
+        } else {
+            v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
+            x[b] = wide_layer_argument(c, high[b], low[b]);
+        }
         if (b % 2) root_start_pair(x[b - 1], x[b], &z[b - 1], &z[b]);
     }
     return check_passed(&check);
 }
 
 /* sp_oss_unpack and sp_grid_to_weights for K = 4 on `pairs` NBLOCK-lane blocks (2 BLOCK each) of
- * codes, in stages: the code check, halves and the layer root's float start; the root's finish
+ * codes (whole: all below WIDE_WHOLE_CODES, a constant in each walk, wide_decode_chunk4 and
+ * _whole: the codes' halves and their sums skipped, in cache ~1.07x as fast on AVX2 at 52 bits),
+ * in stages: the code check, halves and the layer root's float start; the root's finish
  * and the layer; the rest, the layer check and the row estimate (one stage: moving the root's
  * finish or the row's square root into a neighbouring stage ran 10-15% slower); the rows in
  * 32-bit lanes and the weights. Then the scalar redo of the lanes it missed; nothing written
  * where a code is above max_code (returns 0); constants: the wide_codec. */
+#define WIDE_WHOLE_CODES ((uint64_t)1 << 52) /* codes below it are exact doubles (load_codes) */
 #define WIDE_CHUNK4 (2 * DECODE_CHUNK) /* blocks: in cache ~1.04x as fast as DECODE_CHUNK (AVX2), twice as many 1.01x more */
 
-SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* constants, const uint64_t* codes,
-                                         size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
+SP_INLINE SIMD_FN int wide_decode_pairs(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t pairs,
+                                        float* weights, uint32_t k, const simd_layout* layout, int whole)
 {
     const wide_codec* c = (const wide_codec*)constants;
     vec x[WIDE_CHUNK4], layer[WIDE_CHUNK4], biased[WIDE_CHUNK4], row[WIDE_CHUNK4];
-    vec high[WIDE_CHUNK4], low[WIDE_CHUNK4]; /* the codes' 32-bit halves */
+    vec high[WIDE_CHUNK4], low[WIDE_CHUNK4]; /* the codes' 32-bit halves, or the whole codes in low */
     root z[WIDE_CHUNK4];
     unsigned outside[WIDE_CHUNK4], missed[WIDE_CHUNK4 / 2], any = 0; /* lanes as bits */
     size_t blocks = 2 * pairs;
-    if (!wide_layer_start(codec, c, codes, blocks, weights, layout, high, low, x, z)) return 0; /* nothing written yet */
+    if (!wide_layer_start(codec, c, codes, blocks, weights, layout, whole, high, low, x, z)) return 0; /* nothing written yet */
     for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
     for (size_t b = 0; b < blocks; ++b) {
         vec apex = v_fnmadd(layer[b], v_splat(4.0), v_splat(2 * c->n + 1));
-        biased[b] = wide_biased_rest(c, high[b], low[b], layer[b], apex);
+        biased[b] = wide_biased_rest(c, high[b], low[b], layer[b], apex, whole);
         vec w = v_sub(biased[b], v_splat(ROUNDING_MAGIC));
         vec mirrored = row_mirrored(apex, w);
         outside[b] = wide_layer_outside(w, mirrored);
@@ -451,7 +466,20 @@ SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* cons
     return 1;
 }
 
+SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                         size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
+{
+    return wide_decode_pairs(codec, constants, codes, pairs, weights, k, layout, 0);
+}
+
+SP_INLINE SIMD_FN int wide_decode_chunk4_whole(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                               size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
+{
+    return wide_decode_pairs(codec, constants, codes, pairs, weights, k, layout, 1);
+}
+
 DEFINE_DECODE_WALK(wide_decode_walk4, wide_decode_chunk4, NBLOCK, WIDE_CHUNK4 / 2, 0)
+DEFINE_DECODE_WALK(wide_decode_walk4_whole, wide_decode_chunk4_whole, NBLOCK, WIDE_CHUNK4 / 2, 0)
 
 /* sp_oss_unpack and sp_grid_to_weights for K = 2, 3 on `blocks` blocks of codes, in stages (K = 3:
  * the code check and the row estimate, the rest), then the scalar redo of the lanes it missed;
@@ -499,8 +527,10 @@ SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* co
 {
     simd_layout layout = layout_for(k);
     layout.stream = stream;
-    size_t v = k == 4 ? wide_decode_walk4(codec, constants, codes, 0, count, weights, k, &layout)
-                      : wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    size_t v;
+    if (k == 4 && codec->max_code < WIDE_WHOLE_CODES) v = wide_decode_walk4_whole(codec, constants, codes, 0, count, weights, k, &layout);
+    else if (k == 4) v = wide_decode_walk4(codec, constants, codes, 0, count, weights, k, &layout);
+    else v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
     if (stream) _mm_sfence(); /* as decode_lanes */
     return v;
 }
