@@ -9,7 +9,7 @@
  * 1) / 4) as j (N - j) + floor((j + 1)^2 / 4), since a floor by 4 does not commute with a
  * reduction mod 2^64). Decode needs only the differences code - base, which are small where
  * they matter, so it takes them in double lanes from the code's 32-bit halves and a base split
- * into an exact FMA product and its residual (wide_layer_rest, wide_row_offset): exact wherever
+ * into an exact FMA product and its residual (wide_biased_rest, wide_row_offset): exact wherever
  * the difference lies in or next to the row or layer, past every row's codes elsewhere.
  * The root estimates stay in double lanes: their arguments (apex^2 + 3 - 12w for rows,
  * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
@@ -36,6 +36,8 @@
  *   load_pairs(w, &first, &second) (K = 2 weights as two component vectors), m_eq,
  *   v_keep_where(x, m) = m ? x : +0, v_below_where(x, m) (the double below x > 0 where m),
  *   u_bits (a vec's bits as they are): for K = 2 encode past 2^50 grids (wide_pair_start)
+ *   i_low_pair(a, b)   two blocks' lanes' low 32 bits as NBLOCK int32 (K = 4 rows in 32-bit lanes)
+ *   store_quotients32  store_weights32 by division, exact for every s < 2^24
  * and WIDE_NAME(name), the entry points' names.
  */
 
