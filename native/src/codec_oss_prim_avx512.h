@@ -98,6 +98,12 @@ SP_INLINE SIMD_FN nvec f_from_pair(vec a, vec b)
 {
     return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(a)), _mm512_cvtpd_ps(b), 1);
 }
+/* The low 32 bits of each lane of two blocks (as bits), as NBLOCK int32 lanes in order. */
+SP_INLINE SIMD_FN nint i_low_pair(vec a, vec b)
+{
+    __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    return _mm512_permutex2var_epi32(_mm512_castpd_si512(a), even, _mm512_castpd_si512(b));
+}
 /* The inverse for int32: NBLOCK int32 lanes as two blocks of doubles (exact). */
 SP_INLINE SIMD_FN void v_from_i_pair(nint a, vec* first, vec* second)
 {
@@ -236,9 +242,22 @@ SP_INLINE SIMD_FN void store_pair(const vec* first, const vec* second, uint32_t 
     store_weights(second, k, inverse, layout, out + BLOCK * k);
 }
 
+/* Sixteen vertices of k floats from k component vectors (w[3] overwritten for k = 3): each half
+ * as store_weights stores it. */
+SP_INLINE SIMD_FN void store_floats16(__m512* w, uint32_t k, const simd_layout* layout, float* out)
+{
+    if (k == 3) w[3] = w[2]; /* the unused pair half */
+    /* pairs (c, c + 1) of vertices 0..7 (the low halves: 0x44) and 8..15 (the high ones: 0xEE) */
+    __m512 pairs[2][2] = {{_mm512_shuffle_f32x4(w[0], w[1], 0x44)}, {_mm512_shuffle_f32x4(w[0], w[1], 0xEE)}};
+    pairs[0][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0x44) : pairs[0][0];
+    pairs[1][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0xEE) : pairs[1][0];
+    SP_UNROLL
+    for (uint32_t half = 0; half < 2; ++half) store_vertices8(pairs[half], k, layout, out + half * BLOCK * k);
+}
+
 /* store_weights of sixteen vertices from int32 components 0 <= q <= s < 2^24: in float lanes
  * by Markstein's correction of q r, the correctly rounded q/s as the double product (see
- * store_weights32 in codec_oss_prim_avx2.h), then each half as store_weights stores it. */
+ * store_weights32 in codec_oss_prim_avx2.h). */
 SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
 {
     __m512 w[SP_MAX_INFLUENCES], s = _mm512_set1_ps((float)scale), r = _mm512_set1_ps(1.0f / (float)scale);
@@ -247,13 +266,16 @@ SP_INLINE SIMD_FN void store_weights32(const nint* q, uint32_t k, double scale, 
         __m512 x = _mm512_cvtepi32_ps(q[i]), y = _mm512_mul_ps(x, r);
         w[i] = _mm512_fmadd_ps(_mm512_fnmadd_ps(y, s, x), r, y);
     }
-    if (k == 3) w[3] = w[2]; /* the unused pair half */
-    /* pairs (c, c + 1) of vertices 0..7 (the low halves: 0x44) and 8..15 (the high ones: 0xEE) */
-    __m512 pairs[2][2] = {{_mm512_shuffle_f32x4(w[0], w[1], 0x44)}, {_mm512_shuffle_f32x4(w[0], w[1], 0xEE)}};
-    pairs[0][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0x44) : pairs[0][0];
-    pairs[1][1] = k > 2 ? _mm512_shuffle_f32x4(w[2], w[3], 0xEE) : pairs[1][0];
+    store_floats16(w, k, layout, out);
+}
+
+/* store_weights32 by division, for every s < 2^24 (store_quotients32 in codec_oss_prim_avx2.h). */
+SP_INLINE SIMD_FN void store_quotients32(const nint* q, uint32_t k, double scale, const simd_layout* layout, float* out)
+{
+    __m512 w[SP_MAX_INFLUENCES], s = _mm512_set1_ps((float)scale);
     SP_UNROLL
-    for (uint32_t half = 0; half < 2; ++half) store_vertices8(pairs[half], k, layout, out + half * BLOCK * k);
+    for (uint32_t i = 0; i < k; ++i) w[i] = _mm512_div_ps(_mm512_cvtepi32_ps(q[i]), s);
+    store_floats16(w, k, layout, out);
 }
 
 SP_INLINE SIMD_FN vec load_codes(const uint64_t* codes, code_check* check)

@@ -464,12 +464,22 @@ SP_INLINE SIMD_FN vec layer_estimate(double n, vec t)
  * rounded sqrt keeps the rounding error far below the 1/8 margin up to the largest N. No clamp
  * to the last row: the estimate is at most apex / 3 < rows + 1, and row_offset rejects
  * j = rows (a row of no codes). */
+SP_INLINE SIMD_FN vec row_mirrored(vec apex, vec w)
+{
+    return v_fnmadd(w, v_splat(12.0), v_fmsub(apex, apex, v_splat(7.5)));
+}
+
+/* The estimate from apex and the mirrored argument (0 where that is NaN or negative). */
+SP_INLINE SIMD_FN vec row_from_mirrored(vec apex, vec mirrored)
+{
+    vec estimate = v_mul(v_sub(apex, v_sqrt(mirrored)), v_splat(1.0 / 3.0));
+    return v_max(v_floor(estimate), v_zero());
+}
+
 SP_INLINE SIMD_FN vec row_estimate(vec bottom, vec w)
 {
     vec apex = v_fmadd(bottom, v_splat(2.0), v_splat(1.0));
-    vec mirrored = v_fnmadd(w, v_splat(12.0), v_fmsub(apex, apex, v_splat(7.5)));
-    vec estimate = v_mul(v_sub(apex, v_sqrt(mirrored)), v_splat(1.0 / 3.0));
-    return v_max(v_floor(estimate), v_zero());
+    return row_from_mirrored(apex, row_mirrored(apex, w));
 }
 
 /* i = w - s(j), and *ok the lanes where j is w's row, that is where i is in
@@ -768,18 +778,31 @@ SP_INLINE SIMD_FN nint split_row_estimate(nint bottom, nvec mirrored)
     return i_max(i_trunc(estimate), i_splat(0));
 }
 
+/* i = w - s_B(j) in row j of the triangle with bottom B (int32 arithmetic, so exact modulo 2^32:
+ * exact wherever |i| < 2^31) and *last, row j's last offset B - 1 - j - ceil(j / 2). */
+SP_INLINE SIMD_FN nint n_row_offset(nint bottom, nint j, nint w, nint* last)
+{
+    nint one = i_splat(1), room = i_sub(bottom, j), half = i_shr1(i_add(j, one)), half_up = i_shr1(i_add(j, i_splat(2)));
+    *last = i_sub(i_sub(room, one), half);
+    return i_sub(w, i_add(i_mullo(j, room), i_mullo(half, half_up)));
+}
+
+/* The lanes whose offset i is outside [0, last], as bits. */
+SP_INLINE SIMD_FN unsigned n_outside(nint i, nint last)
+{
+    return n_bits(n_or(i_gt(i_splat(0), i), i_gt(i, last)));
+}
+
 /* The row j of w from its estimate (j or j - 1) by one step up, the offset i in it and the
  * components into q; returns the lanes whose (j, i) is not proven (i outside the row), as bits. */
 SP_INLINE SIMD_FN unsigned split_unpack(double n, nint layer, nint bottom, nint j, nint w, nint* q)
 {
-    nint one = i_splat(1), room = i_sub(bottom, j), half = i_shr1(i_add(j, one)), half_up = i_shr1(i_add(j, i_splat(2)));
-    nint i = i_sub(w, i_add(i_mullo(j, room), i_mullo(half, half_up)));
-    nint last = i_sub(i_sub(room, one), half); /* row j's last offset, B - 1 - j - ceil(j / 2) */
+    nint one = i_splat(1), last, i = n_row_offset(bottom, j, w, &last);
     nmask above = i_gt(i, last);
     i = i_sub_where(i, above, i_add(last, one));
     j = i_add_where(j, above, one);
     last = i_sub(i_sub(i_sub(bottom, j), one), i_shr1(i_add(j, one)));
-    unsigned missed = n_bits(n_or(i_gt(i_splat(0), i), i_gt(i, last)));
+    unsigned missed = n_outside(i, last);
     n_components(n, 4, layer, j, i, q);
     return missed;
 }

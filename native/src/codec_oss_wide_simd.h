@@ -9,7 +9,7 @@
  * 1) / 4) as j (N - j) + floor((j + 1)^2 / 4), since a floor by 4 does not commute with a
  * reduction mod 2^64). Decode needs only the differences code - base, which are small where
  * they matter, so it takes them in double lanes from the code's 32-bit halves and a base split
- * into an exact FMA product and its residual (wide_layer_rest, wide_row_offset): exact wherever
+ * into an exact FMA product and its residual (wide_biased_rest, wide_row_offset): exact wherever
  * the difference lies in or next to the row or layer, past every row's codes elsewhere.
  * The root estimates stay in double lanes: their arguments (apex^2 + 3 - 12w for rows,
  * 8M^3 + 12M^2 - 106 - 144 code for layers, up to 2^73) are summed from exact pieces
@@ -36,6 +36,8 @@
  *   load_pairs(w, &first, &second) (K = 2 weights as two component vectors), m_eq,
  *   v_keep_where(x, m) = m ? x : +0, v_below_where(x, m) (the double below x > 0 where m),
  *   u_bits (a vec's bits as they are): for K = 2 encode past 2^50 grids (wide_pair_start)
+ *   i_low_pair(a, b)   two blocks' lanes' low 32 bits as NBLOCK int32 (K = 4 rows in 32-bit lanes)
+ *   store_quotients32  store_weights32 by division, exact for every s < 2^24
  * and WIDE_NAME(name), the entry points' names.
  */
 
@@ -335,65 +337,172 @@ SP_INLINE SIMD_FN vec wide_layer_argument(const wide_codec* c, vec high, vec low
     return wide_argument(c->root_high, c->root_low, 144.0, high, low);
 }
 
-/* K = 4: rest w = code - u(k) for the estimated layer k, all in double lanes (no 64-bit
- * products: AVX2 builds each from three 32-bit ones), from the code's 32-bit halves (v_halves).
- * u(k) = A k + floor((r k + 2) / 9) with A = floor(c / 9) and r = c mod 9 (wide_layer_split's
- * form: c < 2^48, A < 2^45, k < 2^22), and A k = p + e exactly, p the rounded product and
- * e = A k - p by FMA, so w = (((2^32 high - p) - e) + low) - floor((r k + 2) / 9). The first
- * difference rounds once, to itself wherever its integer value is below 2^53, and each later
- * step is exact while its sum stays below 2^53; so a step that rounds leaves a magnitude past
- * 2^53, and the rest ends past 2^52 either way (negative or not, as the exact rest). A rest in
- * the layer (below 2^44) is thus exact, and one past it (a wrong layer estimate) stays outside
- * every layer's triangle: the row check, which accepts only a rest inside the triangle, proves
- * the layer. */
-SP_INLINE SIMD_FN vec wide_layer_rest(const wide_codec* c, vec high, vec low, vec k)
+/* K = 4: ROUNDING_MAGIC + w for the rest w = code - u(k) of the estimated layer k, in double
+ * lanes from the code's 32-bit halves (v_halves), with no 64-bit products (AVX2 builds each
+ * from three 32-bit ones) and no floors. With a = c k + 2 = 9 u(k) + r (layer_base's Horner form:
+ * c < 2^48 exact, k < 2^22, 0 <= r < 9), x = 9 code - c k + 2 = 9 w + 4 - r puts x / 9 within 4/9
+ * of w, so one FMA rounding x / 9 + ROUNDING_MAGIC to the nearest integer gives ROUNDING_MAGIC + w
+ * (codec_oss_simd.h's biased_ninth: the product with the rounded 1/9 is within 1/36 of x / 9 for
+ * |x| < 2^51). x is summed from exact pieces: c k = p + e (p the rounded product, e its FMA
+ * residual) and 9 code = 9 2^32 high + 9 low (both exact), x = ((9 2^32 high - p) - e) + (9 low + 2).
+ * Each difference is of integers and exact wherever its value is below 2^53 (p is an integer),
+ * so exact wherever x is (|e| <= 2^16, 9 low + 2 < 2^37): a rest in the layer (below 2^44) is
+ * exact. Otherwise the first step that rounds leaves a magnitude past 2^53 - 2^37, and rounding
+ * is monotone: x ends past 2^52.9 with the exact value's sign, and so does the rest past 2^49,
+ * outside every layer (wide_layer_outside). apex = 2N + 1 - 4k (the caller's); with `whole`, low
+ * is the code itself (below 2^52) and high unused. */
+SP_INLINE SIMD_FN vec wide_biased_rest(const wide_codec* c, vec high, vec low, vec k, vec apex, int whole)
 {
-    vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
-    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6));
-    vec ninth = v_floor(v_fmadd(inner, v_splat(1.0 / 9.0), v_splat(0.5 / 9.0)));
-    vec small = v_floor(v_mul(v_fmadd(v_fnmadd(ninth, v_splat(9.0), inner), k, v_splat(2.5)), v_splat(1.0 / 9.0)));
-    vec product = v_mul(ninth, k), error = v_fmsub(ninth, k, product);
-    vec difference = v_fmsub(high, v_splat(0x1p32), product);
-    return v_sub(v_add(v_sub(difference, error), low), small);
+    vec slope = v_sub(v_splat(-(4 * c->n + 8)), apex); /* 4k - 6N - 9 from apex = 2N + 1 - 4k: an add, not an FMA */
+    vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 6)); /* c */
+    vec product = v_mul(inner, k), error = v_fmsub(inner, k, product), x;
+    if (whole) /* low is the code: ((9 code - p) - e) + 2, 9 code exact in the FMA, the same steps' exactness */
+        x = v_add(v_sub(v_fmsub(low, v_splat(9.0), product), error), v_splat(2.0));
+    else
+        x = v_add(v_sub(v_fmsub(high, v_splat(9 * 0x1p32), product), error), v_fmadd(low, v_splat(9.0), v_splat(2.0)));
+    return v_fmadd(x, v_splat(1.0 / 9.0), v_splat(ROUNDING_MAGIC));
 }
 
-/* sp_oss_unpack and sp_grid_to_weights for `blocks` blocks of codes, in stages as in
- * codec_oss_simd.h (K = 4: the code check, the codes' halves and the layer root's float start;
- * the root's finish and the layer; the rest and the row estimate, in one stage: ~10% faster than
- * two on AVX2, where moving the root's finish or the row's square root into a neighbouring
- * stage ran 10-15% slower; the rest. K = 3: the code check and the row estimate, the rest),
- * then the scalar redo of the lanes it missed; nothing written where a code is above max_code
- * (returns 0); constants: the wide_codec. */
+/* K = 4: the lanes whose rest w is outside layer k's triangle (bottom B = N - 2k), as bits:
+ * unless 0 <= w < S(B) = floor((B^2 + B + 1) / 3). With apex = 2B + 1 the row root's argument
+ * mirrored = apex^2 - 7.5 - 12 w (row_mirrored: exact, a multiple of 1/2 below 2^52 for
+ * |w| < 2^47; past that rounded, with its sign) is 4 (B (B + 1) - 3w) - 6.5, positive exactly
+ * where B (B + 1) - 3w >= 2, that is 3 (w + 1) <= B^2 + B + 1, w < S(B). */
+SP_INLINE SIMD_FN unsigned wide_layer_outside(vec w, vec mirrored)
+{
+    return ~m_bits(m_and(m_ge(w, v_zero()), m_gt(mirrored, v_zero()))) & ((1u << BLOCK) - 1);
+}
+
+/* K = 4: ROUNDING_MAGIC + the row estimate of row_from_mirrored for a rest in the layer, but
+ * its floor the nearest integer to estimate - 1/2 (a tie, an estimate exactly an integer, may go
+ * one row lower), and no clamp to row 0: a row j or j - 1 where row_from_mirrored gives j, whose
+ * offset stays below three rows' lengths. */
+SP_INLINE SIMD_FN vec wide_biased_row(vec apex, vec mirrored)
+{
+    vec estimate = v_fmadd(v_sub(apex, v_sqrt(mirrored)), v_splat(1.0 / 3.0), v_splat(-0.5));
+    return v_add(estimate, v_splat(ROUNDING_MAGIC));
+}
+
+/*
+ * K = 4 with the rows in 32-bit lanes. Past the layer and its rest (double lanes: the layer
+ * root of codec_oss_simd.h, wide_biased_rest), the row estimate runs in double (row_estimate's
+ * correctly rounded root: the row itself for every rest in the layer but those within its
+ * rounding of a row start), and the rest in NBLOCK int32 lanes, twice as many an operation:
+ * the offset i = w - s_B(j) modulo 2^32 from w's low 32 bits (the bits of ROUNDING_MAGIC + w),
+ * the exact row check (0 <= i <= last), the components (q <= s < 2^24) and the weights
+ * (store_quotients32's correctly rounded q / s, the scalar's double product too for s < 2^24).
+ * Modulo 2^32 is exact where |i| < 2^31, which holds where w is in the layer (its row estimate
+ * then is w's row or next to it, |i| below two rows' lengths, 2^25): so the layer is checked
+ * first, in double (wide_layer_outside), and a rest outside it sent to the scalar code with
+ * whatever the 32-bit lanes made of it. Then, as in decode_chunk, a rest in the layer that the
+ * row check accepts proves (k, j, i).
+ */
+/* The first stage of K = 4's wide decode over `blocks` blocks: each block's codes checked, their
+ * halves (v_halves), or with `whole` (codes below WIDE_WHOLE_CODES) the codes themselves in low,
+ * the layer root's argument and its float start (root_start_pair: ~5% faster on AVX2 than one by
+ * one); returns whether every code passed. The whole codes' argument (root_high - 144 code) +
+ * root_low is exact where small as wide_argument's is (a difference of multiples of 16 below
+ * 2^57, then an integer below 2^20 added), rounded at most twice where large. */
+SP_INLINE SIMD_FN int wide_layer_start(const sp_codec* codec, const wide_codec* c, const uint64_t* codes, size_t blocks,
+                                       float* weights, const simd_layout* layout, int whole, vec* high, vec* low, vec* x,
+                                       root* z)
+{
+    code_check check = check_start(codec->max_code);
+    for (size_t b = 0; b < blocks; ++b) {
+        prefetch_decode(layout, weights + b * BLOCK * 4, 4, codes + b * BLOCK, BLOCK);
+        vec code = load_codes(codes + b * BLOCK, &check); /* exact below 2^52 */
+        if (whole) {
+            low[b] = code;
+            x[b] = v_add(v_fnmadd(code, v_splat(144.0), v_splat(c->root_high)), v_splat(c->root_low));
+        } else {
+            v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
+            x[b] = wide_layer_argument(c, high[b], low[b]);
+        }
+        if (b % 2) root_start_pair(x[b - 1], x[b], &z[b - 1], &z[b]);
+    }
+    return check_passed(&check);
+}
+
+/* sp_oss_unpack and sp_grid_to_weights for K = 4 on `pairs` NBLOCK-lane blocks (2 BLOCK each) of
+ * codes (whole: all below WIDE_WHOLE_CODES, a constant in each walk, wide_decode_chunk4 and
+ * _whole: the codes' halves and their sums skipped, in cache ~1.07x as fast on AVX2 at 52 bits),
+ * in stages: the code check, halves and the layer root's float start; the root's finish
+ * and the layer; the rest, the layer check and the row estimate (one stage: moving the root's
+ * finish or the row's square root into a neighbouring stage ran 10-15% slower); the rows in
+ * 32-bit lanes and the weights. Then the scalar redo of the lanes it missed; nothing written
+ * where a code is above max_code (returns 0); constants: the wide_codec. */
+#define WIDE_WHOLE_CODES ((uint64_t)1 << 52) /* codes below it are exact doubles (load_codes) */
+#define WIDE_CHUNK4 (2 * DECODE_CHUNK) /* blocks: in cache ~1.04x as fast as DECODE_CHUNK (AVX2), twice as many 1.01x more */
+
+SP_INLINE SIMD_FN int wide_decode_pairs(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t pairs,
+                                        float* weights, uint32_t k, const simd_layout* layout, int whole)
+{
+    const wide_codec* c = (const wide_codec*)constants;
+    vec x[WIDE_CHUNK4], layer[WIDE_CHUNK4], biased[WIDE_CHUNK4], row[WIDE_CHUNK4];
+    vec high[WIDE_CHUNK4], low[WIDE_CHUNK4]; /* the codes' 32-bit halves, or the whole codes in low */
+    root z[WIDE_CHUNK4];
+    unsigned outside[WIDE_CHUNK4], missed[WIDE_CHUNK4 / 2], any = 0; /* lanes as bits */
+    size_t blocks = 2 * pairs;
+    if (!wide_layer_start(codec, c, codes, blocks, weights, layout, whole, high, low, x, z)) return 0; /* nothing written yet */
+    for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
+    for (size_t b = 0; b < blocks; ++b) {
+        vec apex = v_fnmadd(layer[b], v_splat(4.0), v_splat(2 * c->n + 1));
+        biased[b] = wide_biased_rest(c, high[b], low[b], layer[b], apex, whole);
+        vec w = v_sub(biased[b], v_splat(ROUNDING_MAGIC));
+        vec mirrored = row_mirrored(apex, w);
+        outside[b] = wide_layer_outside(w, mirrored);
+        row[b] = wide_biased_row(apex, mirrored);
+    }
+    for (size_t p = 0; p < pairs; ++p) {
+        nint q[SP_MAX_INFLUENCES], last;
+        vec magic = v_splat(ROUNDING_MAGIC);
+        nint layers = i_low_pair(v_add(layer[2 * p], magic), v_add(layer[2 * p + 1], magic));
+        nint j = i_low_pair(row[2 * p], row[2 * p + 1]);
+        nint bottom = i_sub(i_splat((int32_t)c->n), i_add(layers, layers));
+        nint i = n_row_offset(bottom, j, i_low_pair(biased[2 * p], biased[2 * p + 1]), &last);
+        any |= missed[p] = n_outside(i, last) | outside[2 * p] | outside[2 * p + 1] << BLOCK;
+        n_components(c->n, 4, layers, j, i, q);
+        store_quotients32(q, k, (double)codec->scale, layout, weights + p * NBLOCK * k);
+    }
+    if (any) redo_decode(codec, codes, pairs, NBLOCK, missed, k, weights); /* most chunks have none */
+    return 1;
+}
+
+SP_INLINE SIMD_FN int wide_decode_chunk4(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                         size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
+{
+    return wide_decode_pairs(codec, constants, codes, pairs, weights, k, layout, 0);
+}
+
+SP_INLINE SIMD_FN int wide_decode_chunk4_whole(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                               size_t pairs, float* weights, uint32_t k, const simd_layout* layout)
+{
+    return wide_decode_pairs(codec, constants, codes, pairs, weights, k, layout, 1);
+}
+
+DEFINE_DECODE_WALK(wide_decode_walk4, wide_decode_chunk4, NBLOCK, WIDE_CHUNK4 / 2, 0)
+DEFINE_DECODE_WALK(wide_decode_walk4_whole, wide_decode_chunk4_whole, NBLOCK, WIDE_CHUNK4 / 2, 0)
+
+/* sp_oss_unpack and sp_grid_to_weights for K = 2, 3 on `blocks` blocks of codes, in stages (K = 3:
+ * the code check and the row estimate, the rest), then the scalar redo of the lanes it missed;
+ * nothing written where a code is above max_code (returns 0); constants: the wide_codec. */
 SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                         size_t blocks, float* weights, uint32_t k, const simd_layout* layout)
 {
     const wide_codec* c = (const wide_codec*)constants;
     double inverse = 1.0 / (double)codec->scale;
-    vec x[DECODE_CHUNK], layer[DECODE_CHUNK], rest[DECODE_CHUNK], bottom[DECODE_CHUNK], row[DECODE_CHUNK];
-    vec high[DECODE_CHUNK], low[DECODE_CHUNK]; /* the codes' 32-bit halves (K = 3, 4) */
-    root z[DECODE_CHUNK];
+    vec row[DECODE_CHUNK], high[DECODE_CHUNK], low[DECODE_CHUNK]; /* the codes' 32-bit halves (K = 3) */
     unsigned missed[DECODE_CHUNK], any = 0; /* lanes as bits */
     code_check check = check_start(codec->max_code);
     for (size_t b = 0; b < blocks; ++b) {
         prefetch_decode(layout, weights + b * BLOCK * k, k, codes + b * BLOCK, BLOCK);
         load_codes(codes + b * BLOCK, &check); /* the check only: the lanes are u64 */
-        if (k > 2) v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
-        if (k == 4) {
-            x[b] = wide_layer_argument(c, high[b], low[b]);
-            if (b % 2) root_start_pair(x[b - 1], x[b], &z[b - 1], &z[b]); /* ~5% faster on AVX2 than one by one */
-            else if (b + 1 == blocks) z[b] = root_start(x[b]);
+        if (k == 3) {
+            v_halves(u_load(codes + b * BLOCK), &high[b], &low[b]);
+            row[b] = wide_row_estimate(c, high[b], low[b]);
         }
-        if (k == 3) row[b] = wide_row_estimate(c, high[b], low[b]);
     }
     if (!check_passed(&check)) return 0; /* nothing written yet */
-    if (k == 4) {
-        for (size_t b = 0; b < blocks; ++b) layer[b] = layer_estimate(c->n, root_finish_fine(x[b], z[b]));
-        for (size_t b = 0; b < blocks; ++b) {
-            rest[b] = wide_layer_rest(c, high[b], low[b], layer[b]);
-            bottom[b] = v_fnmadd(layer[b], v_splat(2.0), v_splat(c->n));
-            row[b] = row_estimate(bottom[b], rest[b]);
-        }
-    }
     for (size_t b = 0; b < blocks; ++b) {
         vec q[SP_MAX_INFLUENCES];
         uvec code = u_load(codes + b * BLOCK);
@@ -401,15 +510,9 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
         missed[b] = 0;
         if (k == 2) { /* no grid vectors to build */
             store_pairs(v_from_u_rounded(u_sub(u_splat(c->scale_bits), code)), v_from_u_rounded(code), inverse, layout, out);
-        } else if (k == 3) {
+        } else {
             missed[b] = wide_unpack_rows(c, high[b], low[b], row[b], q);
             store_triples(q, inverse, layout, out);
-        } else {
-            mask ok;
-            vec i = row_offset(bottom[b], row[b], rest[b], &ok);
-            unpacked_block(c->n, 4, layer[b], row[b], i, q);
-            missed[b] = ~m_bits(ok) & ((1u << BLOCK) - 1);
-            store_weights(q, 4, inverse, layout, out);
         }
         any |= missed[b];
     }
@@ -426,7 +529,10 @@ SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* co
 {
     simd_layout layout = layout_for(k);
     layout.stream = stream;
-    size_t v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    size_t v;
+    if (k == 4 && codec->max_code < WIDE_WHOLE_CODES) v = wide_decode_walk4_whole(codec, constants, codes, 0, count, weights, k, &layout);
+    else if (k == 4) v = wide_decode_walk4(codec, constants, codes, 0, count, weights, k, &layout);
+    else v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
     if (stream) _mm_sfence(); /* as decode_lanes */
     return v;
 }
