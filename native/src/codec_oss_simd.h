@@ -23,8 +23,10 @@
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
  *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
  *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
- *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
- *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
+ *                      c_inc_where, c_dec_where (by one where m); COUNTER_BIAS, the double that
+ *                      c_below(c, t) takes t = COUNTER_BIAS + d (d integral, below 2^51) as: the
+ *                      lanes where c < d; c_deficit_fits(t, k): the lanes where 0 <= d < k;
+ *                      r_beats(a, b): the lanes where a > b, for a, b in [+0, 1)
  *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
  *   LOAD_ORDERED (1: the ISA has load_weights_ordered(w, x), K = 4's load_weights and
  *   weights_ordered in one),
@@ -246,47 +248,61 @@ SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const si
     return ordered;
 }
 
+/* The floors' sum, as a tree: one step shorter a chain than the scalar's running difference,
+ * and the same value wherever the deficit it gives is in [0, k) (quantize_round). */
+SP_INLINE SIMD_FN vec floor_sum(const vec* floor, uint32_t k)
+{
+    if (k == 2) return v_add(floor[0], floor[1]);
+    vec pair = v_add(floor[0], floor[1]);
+    return v_add(pair, k == 4 ? v_add(floor[2], floor[3]) : floor[2]);
+}
+
 /* sp_grid_quantize's floors x = w s / sum -> q = trunc(x), remainder = x - q, same operations
- * in the same order for the ordered lanes; returns the deficit s - sum of q. */
+ * in the same order for the ordered lanes; returns the threshold COUNTER_BIAS + the deficit
+ * s - sum of q (the counters' form of it, c_below; one subtraction from a constant). */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
-    vec deficit = v_splat(s);
+    vec floor[SP_MAX_INFLUENCES];
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_mul(w[i], scale), floor = v_trunc(x);
-        remainder[i] = v_sub(x, floor);
-        deficit = v_sub(deficit, floor);
-        if (i > 0) q[i] = floor; /* q[0], which neither the index nor the counts read, not even stored */
+        vec x = v_mul(w[i], scale);
+        floor[i] = v_trunc(x);
+        remainder[i] = v_sub(x, floor[i]);
+        if (i > 0) q[i] = floor[i]; /* q[0], which neither the index nor the counts read, not even stored */
     }
-    return deficit;
+    return v_sub(v_splat(s + COUNTER_BIAS), floor_sum(floor, k));
 }
 
 /*
  * sp_grid_quantize's last step: the deficit goes, one each, to the components with the largest
  * remainders (ties to the lower index), chosen by rank; q[0], which the index and the
  * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
- * for: a deficit in [0, k), where the scalar takes the same path. That also bounds every x by
- * s + 1, so floors and deficit are exact: an x past that makes the deficit negative, and one
- * past 2^53 (or infinite) keeps it so under rounding. Other lanes get some q: they are redone.
+ * for: a deficit in [0, k) (c_deficit_fits), where the scalar takes the same path. That also
+ * bounds every x by s + 1, so floors, their sum (in any order: non-negative integers, each
+ * partial sum at most the whole, below 2^51) and deficit are exact: an x past that makes the
+ * deficit negative, and one past 2^53 (or infinite) keeps it so under rounding. In those lanes
+ * every x is +0 or more (the caller's ordered lanes: x is NaN elsewhere, and so is the deficit),
+ * so every remainder is in [+0, 1), which r_beats may rely on. Other lanes get some q: they are
+ * redone.
  */
-SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remainder, vec* q)
+SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec threshold, const vec* remainder, vec* q)
 {
     counter rank[SP_MAX_INFLUENCES]; /* from 0 to k - 1, so the counters never leave their range */
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(k - 1 - i); /* every later slot beats i ... */
+    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(i); /* every earlier slot beats i ... */
     SP_UNROLL
-    for (uint32_t a = 0; a < k; ++a) { /* ... unless i wins against it; an earlier slot a beats b when it wins */
+    for (uint32_t a = 0; a < k; ++a) { /* ... unless i beats it; a later slot b beats a when its remainder is larger */
         SP_UNROLL
         for (uint32_t b = a + 1; b < k; ++b) {
-            mask a_wins = m_ge(remainder[a], remainder[b]);
-            rank[a] = c_dec_where(rank[a], a_wins);
-            rank[b] = c_inc_where(rank[b], a_wins);
+            mask b_wins = r_beats(remainder[b], remainder[a]);
+            rank[a] = c_inc_where(rank[a], b_wins);
+            rank[b] = c_dec_where(rank[b], b_wins);
         }
     }
-    vec threshold = c_threshold(deficit), one = v_splat(1.0);
+    vec one = v_splat(1.0);
     SP_UNROLL
     for (uint32_t i = 1; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one); /* q[0] is implied */
-    return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
+    return c_deficit_fits(threshold, k);
 }
 
 /*
@@ -350,9 +366,9 @@ SP_INLINE SIMD_FN void store_significant(const vec* q, uint32_t k, uint8_t* out)
 
 /* The rounding of one block's floors: the lanes the vector code cannot prove exact (outside
  * `ordered`, or past the fast path's deficits), as bits. */
-SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q, unsigned ordered)
+SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec threshold, const vec* remainder, vec* q, unsigned ordered)
 {
-    return ~(m_bits(quantize_round(k, deficit, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
+    return ~(m_bits(quantize_round(k, threshold, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
 }
 
 /* sp_grid_quantize of one block into q (which may be w: each floor replaces its weight after
@@ -361,8 +377,8 @@ SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remai
 SP_INLINE SIMD_FN unsigned quantize_block(const vec* w, uint32_t k, double s, vec scale, unsigned ordered, vec* q)
 {
     vec remainder[SP_MAX_INFLUENCES];
-    vec deficit = quantize_floor(w, k, s, scale, q, remainder);
-    return round_block(k, deficit, remainder, q, ordered);
+    vec threshold = quantize_floor(w, k, s, scale, q, remainder);
+    return round_block(k, threshold, remainder, q, ordered);
 }
 
 /* The indices (and counts) of one block's sorted lanes. */
