@@ -23,10 +23,13 @@
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
  *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
  *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
- *                      c_inc_where, c_dec_where (by one where m); COUNTER_BIAS, the double that
- *                      c_below(c, t) takes t = COUNTER_BIAS + d (d integral, below 2^51) as: the
- *                      lanes where c < d; c_deficit_fits(t, k): the lanes where 0 <= d < k;
- *                      r_beats(a, b): the lanes where a > b, for a, b in [+0, 1)
+ *                      c_inc_where, c_dec_where (by one where m); rank_start(i, k) and
+ *                      rank_pair(ra, rb, &rank_a, &rank_b) (slot a < b; remainders in [+0, 1)):
+ *                      with every pair's step, rank[i] counts the slots that beat i, where an
+ *                      earlier slot beats a later one when its remainder is not smaller;
+ *                      COUNTER_BIAS, the double that c_below(c, t) takes t = COUNTER_BIAS + d (d
+ *                      integral, below 2^51) as: the lanes where c < d; c_deficit_fits(t, k): the
+ *                      lanes where 0 <= d < k
  *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
  *   LOAD_ORDERED (1: the ISA has load_weights_ordered(w, x), K = 4's load_weights and
  *   weights_ordered in one),
@@ -248,29 +251,22 @@ SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const si
     return ordered;
 }
 
-/* The floors' sum, as a tree: one step shorter a chain than the scalar's running difference,
- * and the same value wherever the deficit it gives is in [0, k) (quantize_round). */
-SP_INLINE SIMD_FN vec floor_sum(const vec* floor, uint32_t k)
-{
-    if (k == 2) return v_add(floor[0], floor[1]);
-    vec pair = v_add(floor[0], floor[1]);
-    return v_add(pair, k == 4 ? v_add(floor[2], floor[3]) : floor[2]);
-}
-
 /* sp_grid_quantize's floors x = w s / sum -> q = trunc(x), remainder = x - q, same operations
  * in the same order for the ordered lanes; returns the threshold COUNTER_BIAS + the deficit
- * s - sum of q (the counters' form of it, c_below; one subtraction from a constant). */
+ * s - sum of q (the counters' form of it, c_below), by the same running difference from
+ * COUNTER_BIAS + s (integers below 2^53: the same values, shifted, wherever the deficit is in
+ * [0, k), quantize_round). */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
-    vec floor[SP_MAX_INFLUENCES];
+    vec threshold = v_splat(s + COUNTER_BIAS);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_mul(w[i], scale);
-        floor[i] = v_trunc(x);
-        remainder[i] = v_sub(x, floor[i]);
-        if (i > 0) q[i] = floor[i]; /* q[0], which neither the index nor the counts read, not even stored */
+        vec x = v_mul(w[i], scale), floor = v_trunc(x);
+        remainder[i] = v_sub(x, floor);
+        threshold = v_sub(threshold, floor);
+        if (i > 0) q[i] = floor; /* q[0], which neither the index nor the counts read, not even stored */
     }
-    return v_sub(v_splat(s + COUNTER_BIAS), floor_sum(floor, k));
+    return threshold;
 }
 
 /*
@@ -278,27 +274,21 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
  * remainders (ties to the lower index), chosen by rank; q[0], which the index and the
  * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
  * for: a deficit in [0, k) (c_deficit_fits), where the scalar takes the same path. That also
- * bounds every x by s + 1, so floors, their sum (in any order: non-negative integers, each
- * partial sum at most the whole, below 2^51) and deficit are exact: an x past that makes the
- * deficit negative, and one past 2^53 (or infinite) keeps it so under rounding. In those lanes
+ * bounds every x by s + 1, so floors and deficit are exact: an x past that makes the deficit
+ * negative, and one past 2^53 (or infinite) keeps it so under rounding. In those lanes
  * every x is +0 or more (the caller's ordered lanes: x is NaN elsewhere, and so is the deficit),
- * so every remainder is in [+0, 1), which r_beats may rely on. Other lanes get some q: they are
+ * so every remainder is in [+0, 1), which rank_pair may rely on. Other lanes get some q: they are
  * redone.
  */
 SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec threshold, const vec* remainder, vec* q)
 {
     counter rank[SP_MAX_INFLUENCES]; /* from 0 to k - 1, so the counters never leave their range */
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(i); /* every earlier slot beats i ... */
+    for (uint32_t i = 0; i < k; ++i) rank[i] = rank_start(i, k);
     SP_UNROLL
-    for (uint32_t a = 0; a < k; ++a) { /* ... unless i beats it; a later slot b beats a when its remainder is larger */
+    for (uint32_t a = 0; a < k; ++a)
         SP_UNROLL
-        for (uint32_t b = a + 1; b < k; ++b) {
-            mask b_wins = r_beats(remainder[b], remainder[a]);
-            rank[a] = c_inc_where(rank[a], b_wins);
-            rank[b] = c_dec_where(rank[b], b_wins);
-        }
-    }
+        for (uint32_t b = a + 1; b < k; ++b) rank_pair(remainder[a], remainder[b], &rank[a], &rank[b]);
     vec one = v_splat(1.0);
     SP_UNROLL
     for (uint32_t i = 1; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one); /* q[0] is implied */

@@ -24,7 +24,7 @@
  *   uvec               BLOCK unsigned 64-bit lanes
  *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates)
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
- *   u_mul(a, b)        a b mod 2^64
+ *   u_mul(a, b)        a b mod 2^64; WIDE_INTEGER_PRODUCT 1 where that is one instruction
  *   u_unbias           integral lanes ROUNDING_MAGIC + m as m, |m| < 2^51
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
@@ -116,37 +116,43 @@ SP_INLINE SIMD_FN vec wide_layer_split(const wide_codec* c, vec k, vec* small)
 }
 
 /*
- * The product A k of wide_layer_split's A (< 2^43) and a layer k (< 2^22), up to 2^65, as
- * high + low with high = A k rounded to a multiple of 2^32, returned modulo 2^64 as u64 lanes,
- * and *low = A k - high (|low| <= 2^31) as a double, both exact, in double lanes (one FMA where
- * the 64-bit product took five integer operations, AVX2 having none): A k + SPLIT_MAGIC, with
- * SPLIT_MAGIC = 1.5 2^84, lies in [2^84, 2^85), where the doubles are the multiples of 2^32, so
- * the FMA's t = SPLIT_MAGIC + high; t - SPLIT_MAGIC = high is exact (a multiple of 2^32 below
- * 2^66), and so is the second FMA's A k - high (an integer of at most 32 bits). t's bits are
- * those of SPLIT_MAGIC plus high / 2^32 (one binade), and SPLIT_MAGIC's low 32 bits are zero, so
- * t's bits shifted left by 32 are high modulo 2^64.
+ * The product A k of wide_layer_split's A (< 2^43) and a layer k (< 2^22), up to 2^65, modulo
+ * 2^64, for an index high + z (z integral, ROUNDING_MAGIC + z in [2^52, 2^53)). Where the ISA
+ * has 64-bit integer products (WIDE_INTEGER_PRODUCT) one of them; else (AVX2, whose 64-bit
+ * product takes five operations) high = A k rounded to a multiple of 2^32 by one FMA and the rest
+ * A k - high (|.| <= 2^31) added to z: A k + SPLIT_MAGIC, with SPLIT_MAGIC = 1.5 2^84, lies in
+ * [2^84, 2^85), where the doubles are the multiples of 2^32, so the FMA's t = SPLIT_MAGIC + high;
+ * t - SPLIT_MAGIC = high is exact (a multiple of 2^32 below 2^66), and so is the second FMA's
+ * A k - high (an integer of at most 32 bits). t's bits are those of SPLIT_MAGIC plus high / 2^32
+ * (one binade), and SPLIT_MAGIC's low 32 bits are zero, so t's bits shifted left by 32 are high
+ * modulo 2^64.
  */
 #define SPLIT_MAGIC 0x1.8p84
 
-SP_INLINE SIMD_FN uvec wide_product(vec a, vec k, vec* low)
+SP_INLINE SIMD_FN uvec wide_product(vec a, vec k, vec* z)
 {
+#if WIDE_INTEGER_PRODUCT
+    (void)z;
+    return u_mul(u_from_v(a), u_from_v(k));
+#else
     vec t = v_fmadd(a, k, v_splat(SPLIT_MAGIC));
-    *low = v_fmsub(a, k, v_sub(t, v_splat(SPLIT_MAGIC)));
+    *z = v_add(*z, v_fmsub(a, k, v_sub(t, v_splat(SPLIT_MAGIC))));
     return u_sll(u_bits(t), 32);
+#endif
 }
 
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
  * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: codec_oss_simd.h's biased_row, which
- * also adds the layer base's small part (wide_layer_split) and the product's low part
- * (wide_product), |small + i + low| < 2^36, so every sum before it is exact. */
+ * also adds the layer base's small part (wide_layer_split) and any rest of the product
+ * (wide_product), |small + i + rest| < 2^36, so every sum before it is exact. */
 SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
     if (k == 2) return u_from_v(q[1]);
     if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
-    vec half_apex = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n + 0.5)), small, low;
-    uvec high = wide_product(wide_layer_split(c, q[3], &small), q[3], &low);
-    vec in_layer = biased_row(half_apex, v_sub(q[2], q[3]), v_add(v_add(small, v_sub(q[1], q[2])), low));
-    return u_add(high, u_unbias(in_layer));
+    vec half_apex = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n + 0.5)), small;
+    vec a = wide_layer_split(c, q[3], &small), z = v_add(small, v_sub(q[1], q[2]));
+    uvec high = wide_product(a, q[3], &z);
+    return u_add(high, u_unbias(biased_row(half_apex, v_sub(q[2], q[3]), z)));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
