@@ -53,7 +53,7 @@ SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm256_add_pd(x
 /* Counters as the doubles 2^52 + c, stepped by integer arithmetic on their bits with the all-ones
  * mask lanes (-1): one instruction a step, where v_add_where takes two. The rounding's compares
  * run on the bits too, as 64-bit integers: vpcmpgtq runs on any of the four vector pipes, a double
- * compare on the two that also take every addition, floor and conversion of the encode (~4% faster
+ * compare on the two that also take every addition, floor and conversion of the encode (~3% faster
  * for K = 4). For doubles in [2^52, 2^53) the bits are those of 2^52 plus the integer, and
  * non-negative doubles order as their bits. */
 #define COUNTER_BIAS 4503599627370496.0 /* 2^52 */

@@ -265,11 +265,10 @@ SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const si
 }
 
 /* sp_grid_quantize's floors x = w s / sum (w already x where scaled_first) -> q = trunc(x),
- * remainder = x - q, same operations
- * in the same order for the ordered lanes; returns the threshold COUNTER_BIAS + the deficit
- * s - sum of q (the counters' form of it, c_below), by the same running difference from
- * COUNTER_BIAS + s (integers below 2^53: the same values, shifted, wherever the deficit is in
- * [0, k), quantize_round). */
+ * remainder = x - q, same operations in the same order for the ordered lanes; returns the
+ * threshold COUNTER_BIAS + the deficit s - sum of q (the counters' form of it, c_below), by the
+ * same running difference from COUNTER_BIAS + s (integers below 2^53: the same values, shifted,
+ * wherever the deficit is in [0, k), quantize_round). */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
     vec threshold = v_splat(s + COUNTER_BIAS);
@@ -289,10 +288,11 @@ SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec sca
  * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
  * for: a deficit in [0, k) (c_deficit_fits), where the scalar takes the same path. That also
  * bounds every x by s + 1, so floors and deficit are exact: an x past that makes the deficit
- * negative, and one past 2^53 (or infinite) keeps it so under rounding. In those lanes
- * every x is +0 or more (the caller's ordered lanes: x is NaN elsewhere, and so is the deficit),
- * so every remainder is in [+0, 1), which rank_pair may rely on. Other lanes get some q: they are
- * redone.
+ * negative, and one past 2^53 (or infinite) keeps it so under rounding. In the lanes kept (those
+ * and the caller's ordered ones) every x is +0 or more, or -0 (a -0 weight; its remainder is
+ * +0), so every remainder is in [+0, 1), which rank_pair may rely on: an ordered lane whose x is
+ * NaN (weights all zero, or one infinite) has a NaN deficit, which fails. Other lanes get some q:
+ * they are redone.
  */
 SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec threshold, const vec* remainder, vec* q)
 {
