@@ -51,7 +51,11 @@ SP_INLINE SIMD_FN unsigned m_bits(mask a) { return (unsigned)_mm256_movemask_pd(
 SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm256_add_pd(x, _mm256_and_pd(m, y)); }
 
 /* Counters as the doubles 2^52 + c, stepped by integer arithmetic on their bits with the all-ones
- * mask lanes (-1): one instruction a step, where v_add_where takes two. */
+ * mask lanes (-1): one instruction a step, where v_add_where takes two. The rounding's compares
+ * run on the bits too, as 64-bit integers: vpcmpgtq runs on any of the four vector pipes, a double
+ * compare on the two that also take every addition, floor and conversion of the encode (~3% faster
+ * for K = 4). For doubles in [2^52, 2^53) the bits are those of 2^52 plus the integer, and
+ * non-negative doubles order as their bits. */
 #define COUNTER_BIAS 4503599627370496.0 /* 2^52 */
 typedef __m256d counter;
 SP_INLINE SIMD_FN counter c_splat(uint32_t c) { return v_splat(COUNTER_BIAS + c); }
@@ -63,8 +67,34 @@ SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m)
 {
     return _mm256_castsi256_pd(_mm256_add_epi64(_mm256_castpd_si256(c), _mm256_castpd_si256(m)));
 }
-SP_INLINE SIMD_FN vec c_threshold(vec d) { return v_add(d, v_splat(COUNTER_BIAS)); }
-SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
+SP_INLINE SIMD_FN mask c_below(counter c, vec threshold)
+{
+    return _mm256_castsi256_pd(_mm256_cmpgt_epi64(_mm256_castpd_si256(threshold), _mm256_castpd_si256(c)));
+}
+/* Each slot starts beaten by every earlier one, and a later slot b that beats a (a larger
+ * remainder: the one compare without a negation) takes that back and beats a instead. */
+SP_INLINE SIMD_FN counter rank_start(uint32_t i, uint32_t k)
+{
+    (void)k;
+    return c_splat(i);
+}
+SP_INLINE SIMD_FN void rank_pair(vec ra, vec rb, counter* rank_a, counter* rank_b)
+{
+    mask b_wins = _mm256_castsi256_pd(_mm256_cmpgt_epi64(_mm256_castpd_si256(rb), _mm256_castpd_si256(ra)));
+    *rank_a = c_inc_where(*rank_a, b_wins);
+    *rank_b = c_dec_where(*rank_b, b_wins);
+}
+
+/* 0 <= d < k for t = 2^52 + d. K = 4: t's bits less those of 2^52 (a multiple of 4) in [0, 4),
+ * that is, the bits shifted right by two equal those of 2^52 so shifted (no double below 2^52
+ * nor past 2^52 + 3, NaN included, has them), one shift and one compare where the two bounds'
+ * compares take three operations. */
+SP_INLINE SIMD_FN mask c_deficit_fits(vec threshold, uint32_t k)
+{
+    if (k != 4) return m_and(m_ge(threshold, v_splat(COUNTER_BIAS)), m_lt(threshold, v_splat(COUNTER_BIAS + k)));
+    __m256i top = _mm256_srli_epi64(_mm256_castpd_si256(threshold), 2);
+    return _mm256_castsi256_pd(_mm256_cmpeq_epi64(top, _mm256_srli_epi64(_mm256_castpd_si256(v_splat(COUNTER_BIAS)), 2)));
+}
 
 /* Eight float or int32 lanes for decode in 32-bit lanes. */
 #define NBLOCK 8
@@ -160,28 +190,30 @@ SP_INLINE SIMD_FN void load_weights(const float* w, uint32_t k, const simd_layou
 
 /*
  * K = 4's load_weights and weights_ordered in fewer vector operations (the encode's first stage
- * is bound by them, on the three vector ports): the 4x4 transpose in float lanes goes to memory
- * and each component comes back widened by a load-and-convert, which runs on a load port and one
+ * is bound by them, on the three vector ports): the 4x4 transpose in float lanes, as components
+ * 0 | 2 and 1 | 3 (two shuffles of the even and odd floats, two permutes), goes to memory and
+ * each component comes back widened by a load-and-convert, which runs on a load port and one
  * vector port where the register form takes a shuffle port too and an extract before it; the
  * sorted check runs on the float lanes (the same compares as on the doubles they widen to: -0,
- * NaN alike), components 0 | 1 against 1 | 2 and 2 | 3 against 3 | 0, two compares for four.
+ * NaN alike), components 0 | 2 against 1 | 3 and 1 | 3 against 2 | 0, two compares for four and
+ * one permute for their operands (components 0 | 1 and 2 | 3 took two).
  */
 #define LOAD_ORDERED 1
 SP_INLINE SIMD_FN unsigned load_weights_ordered(const float* w, vec* x)
 {
     __m256 v01 = _mm256_loadu_ps(w), v23 = _mm256_loadu_ps(w + 8);
-    __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7); /* as load_weights */
-    __m256 c01 = _mm256_permutevar8x32_ps(_mm256_unpacklo_ps(v01, v23), order);
-    __m256 c23 = _mm256_permutevar8x32_ps(_mm256_unpackhi_ps(v01, v23), order);
+    __m256i order = _mm256_setr_epi32(0, 4, 2, 6, 1, 5, 3, 7); /* (v0 v0 v2 v2 | v1 v1 v3 v3) -> v0 v1 v2 v3 */
+    __m256 c02 = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(v01, v23, 0x88), order);
+    __m256 c13 = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(v01, v23, 0xDD), order);
     _Alignas(32) float soa[16];
-    _mm256_store_ps(soa, c01);
-    _mm256_store_ps(soa + 8, c23);
+    _mm256_store_ps(soa, c02);
+    _mm256_store_ps(soa + 8, c13);
     SP_FORGET(soa); /* else the compiler forwards the stores to register extracts */
     SP_UNROLL
-    for (uint32_t i = 0; i < 4; ++i) x[i] = _mm256_cvtps_pd(_mm_load_ps(soa + 4 * i));
-    __m256 next = _mm256_permute2f128_ps(c01, c23, 0x21), last = _mm256_permute2f128_ps(c23, c23, 0x81); /* 1 | 2, 3 | 0 */
-    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(c01, next, _CMP_GE_OQ), _mm256_cmp_ps(c23, last, _CMP_GE_OQ));
-    unsigned bits = (unsigned)_mm256_movemask_ps(ok); /* vertex v: bit v (w0 >= w1, w2 >= w3), bit v + 4 (w1 >= w2, w3 >= 0) */
+    for (uint32_t i = 0; i < 4; ++i) x[i] = _mm256_cvtps_pd(_mm_load_ps(soa + 8 * (i % 2) + 4 * (i / 2)));
+    __m256 next = _mm256_permute2f128_ps(c02, c02, 0x81); /* 2 | 0 */
+    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(c02, c13, _CMP_GE_OQ), _mm256_cmp_ps(c13, next, _CMP_GE_OQ));
+    unsigned bits = (unsigned)_mm256_movemask_ps(ok); /* vertex v: bit v (w0 >= w1, w1 >= w2), bit v + 4 (w2 >= w3, w3 >= 0) */
     return bits & (bits >> 4) & 15u;
 }
 
@@ -458,7 +490,7 @@ SP_INLINE SIMD_FN uvec u_add(uvec a, uvec b) { return _mm256_add_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm256_sub_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm256_and_si256(a, b); }
 SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm256_mul_epu32(a, b); }
-SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_add(u_mul32(a, b), u_sll(u_mul32(u_srl(a, 32), b), 32)); }
+#define WIDE_INTEGER_PRODUCT 0 /* codec_oss_wide_simd.h's wide_product: by FMAs */
 SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b)
 {
     uvec cross = u_add(u_mul32(u_srl(a, 32), b), u_mul32(a, u_srl(b, 32)));

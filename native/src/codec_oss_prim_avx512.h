@@ -52,12 +52,25 @@ SP_INLINE SIMD_FN unsigned m_bits(mask a) { return a; }
 SP_INLINE SIMD_FN vec v_add_where(vec x, mask m, vec y) { return _mm512_mask_add_pd(x, m, x, y); }
 
 /* Counters as plain doubles: a masked add is one instruction already. */
+#define COUNTER_BIAS 0.0
 typedef __m512d counter;
 SP_INLINE SIMD_FN counter c_splat(uint32_t c) { return v_splat(c); }
 SP_INLINE SIMD_FN counter c_inc_where(counter c, mask m) { return v_add_where(c, m, v_splat(1.0)); }
 SP_INLINE SIMD_FN counter c_dec_where(counter c, mask m) { return v_add_where(c, m, v_splat(-1.0)); }
-SP_INLINE SIMD_FN vec c_threshold(vec d) { return d; }
 SP_INLINE SIMD_FN mask c_below(counter c, vec threshold) { return m_gt(threshold, c); }
+SP_INLINE SIMD_FN mask c_deficit_fits(vec threshold, uint32_t k)
+{
+    return m_and(m_ge(threshold, v_zero()), m_lt(threshold, v_splat((double)k)));
+}
+/* Each slot starts beaten by every later one (the last from 0: a masked add into zeros, which
+ * the compiler makes a masked move), and an earlier slot a that beats b takes that back. */
+SP_INLINE SIMD_FN counter rank_start(uint32_t i, uint32_t k) { return c_splat(k - 1 - i); }
+SP_INLINE SIMD_FN void rank_pair(vec ra, vec rb, counter* rank_a, counter* rank_b)
+{
+    mask a_wins = m_ge(ra, rb);
+    *rank_a = c_dec_where(*rank_a, a_wins);
+    *rank_b = c_inc_where(*rank_b, a_wins);
+}
 
 /* Sixteen float or int32 lanes for decode in 32-bit lanes. */
 #define NBLOCK 16
@@ -359,7 +372,7 @@ SP_INLINE SIMD_FN uvec u_sub(uvec a, uvec b) { return _mm512_sub_epi64(a, b); }
 SP_INLINE SIMD_FN uvec u_and(uvec a, uvec b) { return _mm512_and_si512(a, b); }
 SP_INLINE SIMD_FN uvec u_mul32(uvec a, uvec b) { return _mm512_mul_epu32(a, b); }
 SP_INLINE SIMD_FN uvec u_mul(uvec a, uvec b) { return _mm512_mullo_epi64(a, b); }
-SP_INLINE SIMD_FN uvec u_mul_u32(uvec a, uvec b) { return u_mul(a, b); }
+#define WIDE_INTEGER_PRODUCT 1 /* codec_oss_wide_simd.h's wide_product: vpmullq */
 SP_INLINE SIMD_FN uvec u_unbias(vec x) /* ROUNDING_MAGIC + m -> m */
 {
     return u_sub(_mm512_castpd_si512(x), _mm512_castpd_si512(v_splat(0x1.8p52)));

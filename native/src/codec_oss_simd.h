@@ -23,8 +23,13 @@
  *   v_fmadd(a, b, c) = ab + c, v_fnmadd = c - ab, v_fmsub = ab - c (fused: exact forms only)
  *   m_ge m_gt m_lt (ordered compares), m_and, m_bits (lanes as bits), v_add_where(x, m, y)
  *   counter            small non-negative integer lanes for the rounding's ranks: c_splat(u),
- *                      c_inc_where, c_dec_where (by one where m), c_threshold(d) of an integral
- *                      vec d (exact below 2^51) and c_below(c, t): the lanes where c < d
+ *                      c_inc_where, c_dec_where (by one where m); rank_start(i, k) and
+ *                      rank_pair(ra, rb, &rank_a, &rank_b) (slot a < b; remainders in [+0, 1)):
+ *                      with every pair's step, rank[i] counts the slots that beat i, where an
+ *                      earlier slot beats a later one when its remainder is not smaller;
+ *                      COUNTER_BIAS, the double that c_below(c, t) takes t = COUNTER_BIAS + d (d
+ *                      integral, below 2^51) as: the lanes where c < d; c_deficit_fits(t, k): the
+ *                      lanes where 0 <= d < k
  *   load_weights, store_weights (AoS floats <-> K vectors), store_pair (two blocks' weights),
  *   LOAD_ORDERED (1: the ISA has load_weights_ordered(w, x), K = 4's load_weights and
  *   weights_ordered in one),
@@ -227,9 +232,18 @@ SP_INLINE SIMD_FN void prefetch_decode(const simd_layout* layout, const float* w
     prefetch_ahead(codes, sizeof(uint64_t), lanes);
 }
 
-/* A block's weights (K vectors), sp_grid_load's scale and the ordered lanes (weights_ordered),
- * the encode's first stage: the ISA's load_weights_ordered where it has one (LOAD_ORDERED),
- * which may load and check the weights in fewer operations (for K = 4 on AVX2). */
+/* Whether the first stage takes the products x = w s / sum too (the rounding's stage then starts
+ * from x): for K = 4, whose first stage leaves the multiply pipes idle while the rounding's
+ * stage is the longest (AVX2 ~1.02x; K = 3 ran ~0.98x, its first stage shorter). */
+SP_INLINE int scaled_first(uint32_t k)
+{
+    return k == 4;
+}
+
+/* A block's weights (K vectors; times the scale where scaled_first), sp_grid_load's scale and
+ * the ordered lanes (weights_ordered), the encode's first stage: the ISA's load_weights_ordered
+ * where it has one (LOAD_ORDERED), which may load and check the weights in fewer operations
+ * (for K = 4 on AVX2). */
 SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const simd_layout* layout, double s, vec* w,
                                       vec* scale)
 {
@@ -243,50 +257,56 @@ SP_INLINE SIMD_FN unsigned load_block(const float* weights, uint32_t k, const si
         ordered = weights_ordered(w, k);
     }
     *scale = quantize_scale(w, k, s);
+    if (scaled_first(k)) {
+        SP_UNROLL
+        for (uint32_t i = 0; i < k; ++i) w[i] = v_mul(w[i], *scale);
+    }
     return ordered;
 }
 
-/* sp_grid_quantize's floors x = w s / sum -> q = trunc(x), remainder = x - q, same operations
- * in the same order for the ordered lanes; returns the deficit s - sum of q. */
+/* sp_grid_quantize's floors x = w s / sum (w already x where scaled_first) -> q = trunc(x),
+ * remainder = x - q, same operations in the same order for the ordered lanes; returns the
+ * threshold COUNTER_BIAS + the deficit s - sum of q (the counters' form of it, c_below), by the
+ * same running difference from COUNTER_BIAS + s (integers below 2^53: the same values, shifted,
+ * wherever the deficit is in [0, k), quantize_round). */
 SP_INLINE SIMD_FN vec quantize_floor(const vec* w, uint32_t k, double s, vec scale, vec* q, vec* remainder)
 {
-    vec deficit = v_splat(s);
+    vec threshold = v_splat(s + COUNTER_BIAS);
     SP_UNROLL
     for (uint32_t i = 0; i < k; ++i) {
-        vec x = v_mul(w[i], scale), floor = v_trunc(x);
+        vec x = scaled_first(k) ? w[i] : v_mul(w[i], scale), floor = v_trunc(x);
         remainder[i] = v_sub(x, floor);
-        deficit = v_sub(deficit, floor);
+        threshold = v_sub(threshold, floor);
         if (i > 0) q[i] = floor; /* q[0], which neither the index nor the counts read, not even stored */
     }
-    return deficit;
+    return threshold;
 }
 
 /*
  * sp_grid_quantize's last step: the deficit goes, one each, to the components with the largest
  * remainders (ties to the lower index), chosen by rank; q[0], which the index and the
  * significant count do not read, is left unrounded. Returns the lanes the fast path is exact
- * for: a deficit in [0, k), where the scalar takes the same path. That also bounds every x by
- * s + 1, so floors and deficit are exact: an x past that makes the deficit negative, and one
- * past 2^53 (or infinite) keeps it so under rounding. Other lanes get some q: they are redone.
+ * for: a deficit in [0, k) (c_deficit_fits), where the scalar takes the same path. That also
+ * bounds every x by s + 1, so floors and deficit are exact: an x past that makes the deficit
+ * negative, and one past 2^53 (or infinite) keeps it so under rounding. In the lanes kept (those
+ * and the caller's ordered ones) every x is +0 or more, or -0 (a -0 weight; its remainder is
+ * +0), so every remainder is in [+0, 1), which rank_pair may rely on: an ordered lane whose x is
+ * NaN (weights all zero, or one infinite) has a NaN deficit, which fails. Other lanes get some q:
+ * they are redone.
  */
-SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec deficit, const vec* remainder, vec* q)
+SP_INLINE SIMD_FN mask quantize_round(uint32_t k, vec threshold, const vec* remainder, vec* q)
 {
     counter rank[SP_MAX_INFLUENCES]; /* from 0 to k - 1, so the counters never leave their range */
     SP_UNROLL
-    for (uint32_t i = 0; i < k; ++i) rank[i] = c_splat(k - 1 - i); /* every later slot beats i ... */
+    for (uint32_t i = 0; i < k; ++i) rank[i] = rank_start(i, k);
     SP_UNROLL
-    for (uint32_t a = 0; a < k; ++a) { /* ... unless i wins against it; an earlier slot a beats b when it wins */
+    for (uint32_t a = 0; a < k; ++a)
         SP_UNROLL
-        for (uint32_t b = a + 1; b < k; ++b) {
-            mask a_wins = m_ge(remainder[a], remainder[b]);
-            rank[a] = c_dec_where(rank[a], a_wins);
-            rank[b] = c_inc_where(rank[b], a_wins);
-        }
-    }
-    vec threshold = c_threshold(deficit), one = v_splat(1.0);
+        for (uint32_t b = a + 1; b < k; ++b) rank_pair(remainder[a], remainder[b], &rank[a], &rank[b]);
+    vec one = v_splat(1.0);
     SP_UNROLL
     for (uint32_t i = 1; i < k; ++i) q[i] = v_add_where(q[i], c_below(rank[i], threshold), one); /* q[0] is implied */
-    return m_and(m_ge(deficit, v_zero()), m_lt(deficit, v_splat((double)k)));
+    return c_deficit_fits(threshold, k);
 }
 
 /*
@@ -350,9 +370,9 @@ SP_INLINE SIMD_FN void store_significant(const vec* q, uint32_t k, uint8_t* out)
 
 /* The rounding of one block's floors: the lanes the vector code cannot prove exact (outside
  * `ordered`, or past the fast path's deficits), as bits. */
-SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remainder, vec* q, unsigned ordered)
+SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec threshold, const vec* remainder, vec* q, unsigned ordered)
 {
-    return ~(m_bits(quantize_round(k, deficit, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
+    return ~(m_bits(quantize_round(k, threshold, remainder, q)) & ordered) & ((1u << BLOCK) - 1);
 }
 
 /* sp_grid_quantize of one block into q (which may be w: each floor replaces its weight after
@@ -361,8 +381,8 @@ SP_INLINE SIMD_FN unsigned round_block(uint32_t k, vec deficit, const vec* remai
 SP_INLINE SIMD_FN unsigned quantize_block(const vec* w, uint32_t k, double s, vec scale, unsigned ordered, vec* q)
 {
     vec remainder[SP_MAX_INFLUENCES];
-    vec deficit = quantize_floor(w, k, s, scale, q, remainder);
-    return round_block(k, deficit, remainder, q, ordered);
+    vec threshold = quantize_floor(w, k, s, scale, q, remainder);
+    return round_block(k, threshold, remainder, q, ordered);
 }
 
 /* The indices (and counts) of one block's sorted lanes. */

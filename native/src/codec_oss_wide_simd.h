@@ -24,7 +24,7 @@
  *   uvec               BLOCK unsigned 64-bit lanes
  *   u_splat u_load u_store u_add u_sub u_and, u_srl(a, n) u_sll(a, n) (immediates)
  *   u_mul32(a, b)      the low 32 bits of each lane multiplied, 64-bit products
- *   u_mul_u32(a, b)    a b mod 2^64 for b < 2^32; u_mul(a, b): a b mod 2^64
+ *   u_mul(a, b)        a b mod 2^64; WIDE_INTEGER_PRODUCT 1 where that is one instruction
  *   u_unbias           integral lanes ROUNDING_MAGIC + m as m, |m| < 2^51
  *   v_from_u (exact below 2^52), v_from_u_rounded (any, rounded to nearest as C converts),
  *   v_halves(a, &high, &low) (a's two 32-bit halves as doubles), u_from_v (integral doubles
@@ -35,7 +35,7 @@
  *   root_start_pair(a, b, &ra, &rb)  root_start of two blocks (in one pass where the ISA can)
  *   load_pairs(w, &first, &second) (K = 2 weights as two component vectors), m_eq,
  *   v_keep_where(x, m) = m ? x : +0, v_below_where(x, m) (the double below x > 0 where m),
- *   u_bits (a vec's bits as they are): for K = 2 encode past 2^50 grids (wide_pair_start)
+ *   u_bits (a vec's bits as they are): wide_product and K = 2 encode past 2^50 grids (wide_pair_start)
  *   i_low_pair(a, b)   two blocks' lanes' low 32 bits as NBLOCK int32 (K = 4 rows in 32-bit lanes)
  *   store_quotients32  store_weights32 by division, exact for every s < 2^24
  * and WIDE_NAME(name), the entry points' names.
@@ -105,31 +105,56 @@ SP_INLINE SIMD_FN vec wide_argument(double high, double low, double factor, vec 
  * (layer_base's Horner form), for encode, split as u(k) = floor(c / 9) k + floor((r k + 2) / 9)
  * with r = c mod 9: c (below 2^46 at 64-bit codes, and positive for k <= (N + 1) / 2) and its
  * quotient are exact doubles, the quotient's floor codec_oss_simd.h's biased_ninth (of c - 4,
- * the 4 taken off the constant), and r k + 2 < 2^26; only floor(c / 9) k (up to 2^69, taken mod
- * 2^64 as the sum is below 2^64) needs the integer lanes: one product where the exact division
- * by 9 modulo 2^64 took three and a table. Returns floor(c / 9) k; *small = ROUNDING_MAGIC +
- * floor((r k + 2) / 9). */
-SP_INLINE SIMD_FN uvec wide_layer_split(const wide_codec* c, vec k, vec* small)
+ * the 4 taken off the constant), and r k + 2 < 2^26. Returns A = floor(c / 9) (below 2^43);
+ * *small = ROUNDING_MAGIC + floor((r k + 2) / 9). */
+SP_INLINE SIMD_FN vec wide_layer_split(const wide_codec* c, vec k, vec* small)
 {
     vec slope = v_fmadd(k, v_splat(4.0), v_splat(-(6 * c->n + 9)));
     vec inner = v_fmadd(slope, k, v_splat(3 * c->n * c->n + 9 * c->n + 2)); /* c - 4 */
-    vec biased = biased_ninth(inner), ninth = v_sub(biased, v_splat(ROUNDING_MAGIC));
+    vec ninth = v_sub(biased_ninth(inner), v_splat(ROUNDING_MAGIC));
     vec rest = v_add(v_fnmadd(ninth, v_splat(9.0), inner), v_splat(4.0));
     *small = biased_ninth(v_fmsub(rest, k, v_splat(2.0)));
-    return u_mul_u32(u_unbias(biased), u_from_v(k));
+    return ninth;
+}
+
+/*
+ * The product A k of wide_layer_split's A (< 2^43) and a layer k (< 2^22), up to 2^65, modulo
+ * 2^64, for an index high + z (z integral, ROUNDING_MAGIC + z in [2^52, 2^53)). Where the ISA
+ * has 64-bit integer products (WIDE_INTEGER_PRODUCT) one of them; else (AVX2, whose 64-bit
+ * product takes five operations) high = A k rounded to a multiple of 2^32 by one FMA and the rest
+ * A k - high (|.| <= 2^31) added to z: A k + SPLIT_MAGIC, with SPLIT_MAGIC = 1.5 2^84, lies in
+ * [2^84, 2^85), where the doubles are the multiples of 2^32, so the FMA's t = SPLIT_MAGIC + high;
+ * t - SPLIT_MAGIC = high is exact (a multiple of 2^32 below 2^66), and so is the second FMA's
+ * A k - high (an integer of at most 32 bits). t's bits are those of SPLIT_MAGIC plus high / 2^32
+ * (one binade), and SPLIT_MAGIC's low 32 bits are zero, so t's bits shifted left by 32 are high
+ * modulo 2^64.
+ */
+#define SPLIT_MAGIC 0x1.8p84
+
+SP_INLINE SIMD_FN uvec wide_product(vec a, vec k, vec* z)
+{
+#if WIDE_INTEGER_PRODUCT
+    (void)z;
+    return u_mul(u_from_v(a), u_from_v(k));
+#else
+    vec t = v_fmadd(a, k, v_splat(SPLIT_MAGIC));
+    *z = v_add(*z, v_fmsub(a, k, v_sub(t, v_splat(SPLIT_MAGIC))));
+    return u_sll(u_bits(t), 32);
+#endif
 }
 
 /* sp_oss_pack on one block of sorted grid lanes (exact integers below 2^35), into 64 bits. The
  * K = 4 in-layer index s_{N-2k}(j) + i stays below 2^47: codec_oss_simd.h's biased_row, which
- * also adds the layer base's small part (wide_layer_split). */
+ * also adds the layer base's small part (wide_layer_split) and any rest of the product
+ * (wide_product), |small + i + rest| < 2^36, so every sum before it is exact. */
 SP_INLINE SIMD_FN uvec wide_pack(const wide_codec* c, const vec* q, uint32_t k)
 {
     if (k == 2) return u_from_v(q[1]);
     if (k == 3) return u_add(wide_row_base(c, u_from_v(q[2])), u_from_v(v_sub(q[1], q[2])));
     vec half_apex = v_fnmadd(q[3], v_splat(2.0), v_splat(c->n + 0.5)), small;
-    uvec layer = wide_layer_split(c, q[3], &small);
-    vec in_layer = biased_row(half_apex, v_sub(q[2], q[3]), v_add(small, v_sub(q[1], q[2])));
-    return u_add(layer, u_unbias(in_layer));
+    vec a = wide_layer_split(c, q[3], &small), z = v_add(small, v_sub(q[1], q[2]));
+    uvec high = wide_product(a, q[3], &z);
+    return u_add(high, u_unbias(biased_row(half_apex, v_sub(q[2], q[3]), z)));
 }
 
 /* The floors, rounding and index of one block: the lanes the vector code cannot prove exact,
@@ -166,10 +191,13 @@ SP_INLINE SIMD_FN void wide_encode_chunk(const sp_codec* codec, const void* cons
     else {
         for (size_t b = 0; b < blocks; ++b) /* the floors replace the weights */
             any |= missed[b] = quantize_block(w[b], k, c->scale, scale[b], ordered[b], w[b]);
-        for (size_t b = 0; b < blocks; ++b) {
-            u_store(codes + b * BLOCK, wide_pack(c, w[b], k));
-            if (significant) store_significant(w[b], k, significant + b * BLOCK);
-        }
+        if (significant)
+            for (size_t b = 0; b < blocks; ++b) {
+                u_store(codes + b * BLOCK, wide_pack(c, w[b], k));
+                store_significant(w[b], k, significant + b * BLOCK);
+            }
+        else /* the loop without the counts' test and pointer in it, as encode_chunk's */
+            for (size_t b = 0; b < blocks; ++b) u_store(codes + b * BLOCK, wide_pack(c, w[b], k));
     }
     if (any) redo_encode(codec, weights, blocks, BLOCK, missed, k, codes, significant); /* most chunks have none */
 }

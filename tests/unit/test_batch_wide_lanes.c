@@ -3,9 +3,14 @@
  * K = 4 past N = 3 * 2^15; AVX2, or AVX-512 where built with LANES_AVX512). test_batch_wide.c
  * compares their output with the scalar code, but a lane they reject is redone by the scalar
  * code, so a broken rest or row offset (one that rejected every lane) would pass it. Here the
- * ISA's driver is compiled into the test with the scalar redo counted: every output still bit-identical, and the redone lanes few, for random
- * codes and for the codes around row starts (where K = 3's estimate, half a row low, must take
- * the step up, and K = 4's rows sit deep inside their layer), up to 64-bit codes.
+ * ISA's driver is compiled into the test with the scalar redo counted: every output still
+ * bit-identical, and the redone lanes few, for random codes and for the codes around row starts
+ * (where K = 3's estimate, half a row low, must take the step up, and K = 4's rows sit deep
+ * inside their layer) and layer starts, up to 64-bit codes.
+ * The same for encode, double and wide lanes, K = 2 to 4, 16- to 64-bit codes: sorted weights of
+ * the bench's mix (one to K of them non-zero) and random ones, which the lanes must take every
+ * one of (a broken rank, deficit check or layer product that rejected lanes would pass
+ * test_batch: the scalar redo gives the same codes).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -24,6 +29,12 @@ static void counted_decode_one(const sp_codec* codec, uint64_t code, float* weig
     sp_oss_decode_one(codec, code, weights);
 }
 #define sp_oss_decode_one counted_decode_one
+static uint64_t counted_encode_one(const sp_codec* codec, const float* weights, uint8_t* significant)
+{
+    ++redone;
+    return sp_oss_encode_one(codec, weights, significant);
+}
+#define sp_oss_encode_one counted_encode_one
 
 #include "../../native/src/codec_oss_wide.h"
 #if LANES_AVX512
@@ -42,6 +53,7 @@ static void counted_decode_one(const sp_codec* codec, uint64_t code, float* weig
 #include "../../native/src/codec_oss_simd.h"
 #include "../../native/src/codec_oss_wide_simd.h"
 #undef sp_oss_decode_one
+#undef sp_oss_encode_one
 
 static sp_codec oss(uint32_t k, uint64_t n)
 {
@@ -126,6 +138,59 @@ static void layer_starts(const sp_codec* c)
     free(codes);
 }
 
+/* Sorted weights summing to about 1: `nonzero` of them from 1..1000 (the bench's), or random
+ * floats in (0, 1] where nonzero is 0. */
+static void sorted_weights(uint32_t k, uint32_t nonzero, float* w)
+{
+    float sum = 0;
+    for (uint32_t i = 0; i < k; ++i) {
+        w[i] = nonzero ? (i < nonzero ? (float)(rng_next() % 1000 + 1) : 0.0f) : (float)(1.0 - rng_unit());
+        sum += w[i];
+    }
+    for (uint32_t i = 1; i < k; ++i) /* descending */
+        for (uint32_t j = i; j > 0 && w[j - 1] < w[j]; --j) {
+            float t = w[j];
+            w[j] = w[j - 1];
+            w[j - 1] = t;
+        }
+    for (uint32_t i = 0; i < k; ++i) w[i] /= sum;
+}
+
+/* Encodes 40000 sorted vertices through the counted lanes (the double ones up to `wide`): every
+ * code of the full blocks bit-identical to sp_encode_weights, and none redone. */
+static void encode_counted(const sp_codec* c, int wide)
+{
+    uint32_t k = c->influences;
+    size_t count = 40000;
+    float* w = malloc(count * k * sizeof(float));
+    uint64_t* codes = malloc(count * sizeof(uint64_t));
+    for (size_t v = 0; v < count; ++v) sorted_weights(k, (uint32_t)(v % (k + 1)), w + v * k);
+    redone = 0;
+    size_t done = wide ? counted_wide_encode(c, w, count, codes, NULL) : counted_encode(c, w, count, codes, NULL);
+    CHECK_MSG(done == count / BLOCK * BLOCK, "encode K=%u N=%llu: %zu of %zu done", k, (unsigned long long)c->n, done, count);
+    for (size_t v = 0, failures = 0; v < done && failures < 5; ++v) {
+        int same = codes[v] == sp_encode_weights(c, w + v * k);
+        CHECK_MSG(same, "encode K=%u N=%llu vertex %zu", k, (unsigned long long)c->n, v);
+        failures += !same;
+    }
+    CHECK_MSG(redone == 0, "encode K=%u N=%llu: %zu of %zu lanes redone", k, (unsigned long long)c->n, redone, done);
+    free(w);
+    free(codes);
+}
+
+static void check_encode(void)
+{
+    static const uint32_t widths[] = {16, 22, 32, 44, 52, 64};
+    /* codec_oss_batch.c's double lanes' largest N per K */
+    static const uint64_t double_max[] = {0, 0, (uint64_t)1 << 48, (uint64_t)1 << 24, (uint64_t)3 << 15};
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
+            sp_codec c;
+            if (sp_codec_from_bits(SP_METHOD_OSS, k, widths[i] - (k == 2 && widths[i] == 64), &c) != SP_OK) continue;
+            encode_counted(&c, c.n > double_max[k]);
+        }
+}
+
 static void check_codec(const sp_codec* c)
 {
     random_codes(c);
@@ -145,6 +210,7 @@ int main(void)
         printf("%s: the CPU lacks the ISA, nothing to check\n", LANES_TEST);
         return 0;
     }
+    check_encode();
     static const uint32_t widths[] = {52, 56, 60, 64};
     for (uint32_t k = 3; k <= 4; ++k)
         for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
