@@ -36,6 +36,8 @@ sp_result sp_meshlet_collect_triangle_joints(sp_meshlet_context* ctx, size_t* er
             return SP_ERR_LIMIT_EXCEEDED;
         }
         ctx->triangle_joint_count[t] = (uint8_t)count;
+        if (count > 0 && list[count - 1] >= ctx->joint_end) /* the list is ascending */
+            ctx->joint_end = list[count - 1] + 1u;
     }
     return SP_OK;
 }
@@ -47,6 +49,17 @@ int sp_meshlet_fits(const sp_meshlet_context* ctx, size_t t)
            ctx->open_joint_count + sp_meshlet_new_joints(ctx, t) <= ctx->options.max_joints;
 }
 
+void sp_meshlet_add_joints(sp_meshlet_context* ctx, size_t t)
+{
+    const uint16_t* list = ctx->triangle_joints + t * SP_MESHLET_TRIANGLE_JOINTS;
+    for (uint32_t i = 0; i < ctx->triangle_joint_count[t]; ++i) {
+        if (ctx->joint_slot[list[i]] != SP_MESHLET_NO_SLOT)
+            continue;
+        ctx->joint_slot[list[i]] = (uint8_t)ctx->open_joint_count;
+        ctx->open_joints[ctx->open_joint_count++] = list[i];
+    }
+}
+
 void sp_meshlet_add(sp_meshlet_context* ctx, size_t t)
 {
     for (int c = 0; c < 3; ++c) {
@@ -56,14 +69,18 @@ void sp_meshlet_add(sp_meshlet_context* ctx, size_t t)
         ctx->vertex_slot[v] = (uint8_t)ctx->open_vertex_count;
         ctx->open_vertices[ctx->open_vertex_count++] = v;
     }
-    const uint16_t* list = ctx->triangle_joints + t * SP_MESHLET_TRIANGLE_JOINTS;
-    for (uint32_t i = 0; i < ctx->triangle_joint_count[t]; ++i) {
-        if (ctx->joint_slot[list[i]] != SP_MESHLET_NO_SLOT)
-            continue;
-        ctx->joint_slot[list[i]] = (uint8_t)ctx->open_joint_count;
-        ctx->open_joints[ctx->open_joint_count++] = list[i];
-    }
+    sp_meshlet_add_joints(ctx, t);
     ctx->open_triangles[ctx->open_triangle_count++] = (uint32_t)t;
+}
+
+int sp_meshlet_add_triangles(sp_meshlet_context* ctx, const uint32_t* triangles, uint32_t count, int check)
+{
+    for (uint32_t i = 0; i < count; ++i) {
+        if (check && !sp_meshlet_fits(ctx, triangles[i]))
+            return 0;
+        sp_meshlet_add(ctx, triangles[i]);
+    }
+    return 1;
 }
 
 /* ---- bounds ---------------------------------------------------------------------------- */

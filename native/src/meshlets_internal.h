@@ -12,7 +12,7 @@
 #include "skinpack.h"
 
 #define SP_MESHLET_NO_SLOT 0xff /* vertex_slot / joint_slot: not in the open meshlet */
-#define SP_JOINT_SLOT_COUNT 65536
+#define SP_JOINT_SLOT_COUNT 65536 /* every joint index a u16 can hold: what a scratch bound must count */
 
 typedef struct sp_meshlet_context {
     /* input */
@@ -29,6 +29,7 @@ typedef struct sp_meshlet_context {
     /* per triangle: its distinct used joints, ascending (SP_MESHLET_TRIANGLE_JOINTS slots) */
     uint16_t* triangle_joints;
     uint8_t* triangle_joint_count;
+    uint32_t joint_end; /* 1 + the largest joint a triangle uses (0: none), for arrays indexed by joint */
 
     /* the open meshlet */
     uint8_t* vertex_slot;  /* vertex_count entries */
@@ -73,7 +74,8 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
 size_t sp_meshlet_tuple_set_slots(size_t vertex_count);
 size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32_t* ids);
 
-/* Fills triangle_joints; fails with SP_ERR_LIMIT_EXCEEDED naming the first triangle over max_joints. */
+/* Fills triangle_joints and joint_end; fails with SP_ERR_LIMIT_EXCEEDED naming the first triangle
+ * over max_joints. */
 sp_result sp_meshlet_collect_triangle_joints(sp_meshlet_context* ctx, size_t* error_triangle);
 
 /* New vertices triangle t would add to the open meshlet (inline: the builders' inner loop). */
@@ -95,10 +97,30 @@ static inline uint32_t sp_meshlet_new_joints(const sp_meshlet_context* ctx, size
     return fresh;
 }
 
+/* Whether a meshlet of `vertices` vertices has room for the 3 new vertices of a triangle that
+ * shares none of them: the steps that move whole meshlets or jump to a disconnected triangle
+ * cannot count on shared vertices, so this is their "underfull" test. */
+static inline int sp_meshlet_vertex_room(const sp_meshlet_options* options, uint32_t vertices)
+{
+    return vertices + 3u <= options->max_vertices;
+}
+
+/* The same with the triangle limit: one more disconnected triangle fits whole. */
+static inline int sp_meshlet_triangle_room(const sp_meshlet_options* options, uint32_t vertices, uint32_t triangles)
+{
+    return sp_meshlet_vertex_room(options, vertices) && triangles < options->max_triangles;
+}
+
 /* Whether t can join the open meshlet without breaking a limit. */
 int sp_meshlet_fits(const sp_meshlet_context* ctx, size_t t);
 /* Adds t to the open meshlet (the caller checked sp_meshlet_fits). */
 void sp_meshlet_add(sp_meshlet_context* ctx, size_t t);
+/* Adds only t's joints to the open meshlet's palette (open_joints), in the order sp_meshlet_add
+ * would: for a meshlet whose vertex and triangle counts are already known. */
+void sp_meshlet_add_joints(sp_meshlet_context* ctx, size_t t);
+/* Adds the listed triangles to the open meshlet in order; with check, stops at the first that
+ * does not fit and returns 0 (those before it stay added: the caller resets). */
+int sp_meshlet_add_triangles(sp_meshlet_context* ctx, const uint32_t* triangles, uint32_t count, int check);
 /* Writes the open meshlet (if it has triangles) to the output and empties it. */
 void sp_meshlet_flush(sp_meshlet_context* ctx);
 /* Empties the open meshlet without writing it. */

@@ -73,11 +73,8 @@ void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a)
 static int add_group(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_t m, int check)
 {
     for (; m != NO_MESHLET; m = plan->next[m])
-        for (uint32_t i = plan->start[m]; i < plan->start[m + 1]; ++i) {
-            if (check && !sp_meshlet_fits(ctx, plan->order[i]))
-                return 0;
-            sp_meshlet_add(ctx, plan->order[i]);
-        }
+        if (!sp_meshlet_add_triangles(ctx, plan->order + plan->start[m], plan->start[m + 1] - plan->start[m], check))
+            return 0;
     return 1;
 }
 
@@ -105,7 +102,7 @@ static size_t list_underfull(const sp_meshlet_context* ctx, sp_meshlet_plan* pla
 {
     size_t count = 0;
     for (uint32_t m = 0; m < plan->count; ++m)
-        if (!plan->merged[m] && (plan->vertex_count[m] + 3u <= ctx->options.max_vertices ||
+        if (!plan->merged[m] && (sp_meshlet_vertex_room(&ctx->options, plan->vertex_count[m]) ||
                                  plan->triangle_count[m] < ctx->options.max_triangles / 2))
             plan->keys[count++] = (uint64_t)rank[plan->order[plan->start[m]]] << 32 | m;
     qsort(plan->keys, count, sizeof(uint64_t), sp_meshlet_compare_u64);

@@ -2,10 +2,10 @@
  * meshlets_pack.c - the skin builder's packing of underfull meshlets by their joints, before
  * the (spatial) merge step.
  *
- * Pieces are the plan's meshlets with room for one more disconnected triangle: the parts closed
- * whole by meshlets_parts.c (which growth never sees), and the few underfull meshlets growth
- * leaves. Pieces are packed into bins, each bin one group of the plan (as the merge step makes
- * them), in two steps:
+ * Pieces are the plan's meshlets with room for the vertices of one more disconnected triangle
+ * (sp_meshlet_vertex_room): the parts closed whole by meshlets_parts.c (which growth never
+ * sees), and the few underfull meshlets growth leaves. Pieces are packed into bins, each bin
+ * one group of the plan (as the merge step makes them), in two steps:
  *
  * 1. Greedy, largest piece first: each piece goes into the open bin that gains the fewest
  *    palette joints, then the fullest one (best fit), else starts a bin. Run twice, "count
@@ -29,7 +29,6 @@
 #define SEARCH_PIECES 1024   /* the local search (quadratic in pieces) runs up to this many pieces */
 #define SEARCH_PASSES 3
 #define NO_PIECE UINT32_MAX
-#define JOINT_MARKS 65536
 
 typedef struct piece {
     uint32_t meshlet;   /* plan meshlet */
@@ -50,16 +49,18 @@ typedef struct packer {
     uint16_t* pool;
     pack_bin* bins;
     uint32_t bin_count;
-    uint32_t* mark; /* per joint: stamp when marked */
+    uint32_t* mark; /* per joint below ctx->joint_end: stamp when marked */
     uint32_t stamp;
 } packer;
 
 size_t sp_meshlet_pack_scratch_bound(size_t triangle_count)
 {
     size_t m = triangle_count; /* plan meshlets, hence pieces and bins, at most */
+    /* the marks take ctx->joint_end entries; the bound is computed before any joint is seen, so it
+     * counts every joint index a u16 can hold */
     return sp_meshlet_align8(m * sizeof(piece)) +
            sp_meshlet_align8(triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t)) +
-           sp_meshlet_align8(m * sizeof(pack_bin)) + sp_meshlet_align8(JOINT_MARKS * sizeof(uint32_t));
+           sp_meshlet_align8(m * sizeof(pack_bin)) + sp_meshlet_align8(SP_JOINT_SLOT_COUNT * sizeof(uint32_t));
 }
 
 /* The pieces, largest first (fewest free vertices, then fewest free triangles, then plan order),
@@ -68,19 +69,21 @@ static void collect_pieces(packer* p, sp_meshlet_context* ctx, const sp_meshlet_
 {
     uint32_t count = 0, pooled = 0;
     for (uint32_t m = 0; m < plan->count; ++m)
-        if (!plan->merged[m] && plan->vertex_count[m] + 3u <= ctx->options.max_vertices)
+        if (!plan->merged[m] && sp_meshlet_vertex_room(&ctx->options, plan->vertex_count[m]))
             keys[count++] = (uint64_t)(ctx->options.max_vertices - plan->vertex_count[m]) << 42 |
                             (uint64_t)(ctx->options.max_triangles - plan->triangle_count[m]) << 32 | m;
     qsort(keys, count, sizeof(uint64_t), sp_meshlet_compare_u64);
     for (uint32_t i = 0; i < count; ++i) {
         uint32_t m = (uint32_t)keys[i];
+        /* before the packing every meshlet is its own group, so the plan's counts are the piece's
+         * own; only the palette is rebuilt */
         for (uint32_t k = plan->start[m]; k < plan->start[m + 1]; ++k)
-            sp_meshlet_add(ctx, plan->order[k]);
+            sp_meshlet_add_joints(ctx, plan->order[k]);
         piece* q = &p->pieces[i];
         q->meshlet = m;
         q->palette = pooled;
-        q->vertices = (uint16_t)ctx->open_vertex_count;
-        q->triangles = (uint16_t)ctx->open_triangle_count;
+        q->vertices = plan->vertex_count[m];
+        q->triangles = plan->triangle_count[m];
         q->joint_count = (uint16_t)ctx->open_joint_count;
         memcpy(p->pool + pooled, ctx->open_joints, ctx->open_joint_count * sizeof(uint16_t));
         pooled += ctx->open_joint_count;
@@ -94,7 +97,7 @@ static void collect_pieces(packer* p, sp_meshlet_context* ctx, const sp_meshlet_
 static uint32_t joints_with(packer* p, uint32_t b, uint32_t skip, uint32_t add)
 {
     if (++p->stamp == 0) { /* wrapped: clear the marks so that no old stamp matches */
-        memset(p->mark, 0, JOINT_MARKS * sizeof(uint32_t));
+        memset(p->mark, 0, p->ctx->joint_end * sizeof(uint32_t));
         p->stamp = 1;
     }
     uint32_t count = 0, stamp = p->stamp;
@@ -190,7 +193,7 @@ static size_t pack_greedy(packer* p, int joints_first)
         uint32_t b = open[best];
         bin_insert(p, b, i, best_joints);
         entries += best_gain;
-        if (p->bins[b].vertices + 3 > o->max_vertices || p->bins[b].triangles >= o->max_triangles)
+        if (!sp_meshlet_triangle_room(o, p->bins[b].vertices, p->bins[b].triangles))
             open[best] = open[--open_count]; /* full: no piece fits any more */
     }
     return entries;
@@ -271,8 +274,8 @@ void sp_meshlet_plan_pack(sp_meshlet_context* ctx, sp_meshlet_plan* plan, unsign
     p.pieces = sp_meshlet_carve(&scratch, plan->count * sizeof(piece));
     p.pool = sp_meshlet_carve(&scratch, ctx->triangle_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
     p.bins = sp_meshlet_carve(&scratch, plan->count * sizeof(pack_bin));
-    p.mark = sp_meshlet_carve(&scratch, JOINT_MARKS * sizeof(uint32_t));
-    memset(p.mark, 0, JOINT_MARKS * sizeof(uint32_t));
+    p.mark = sp_meshlet_carve(&scratch, ctx->joint_end * sizeof(uint32_t));
+    memset(p.mark, 0, ctx->joint_end * sizeof(uint32_t));
     p.stamp = 0;
     collect_pieces(&p, ctx, plan, keys);
     if (p.piece_count < 2)

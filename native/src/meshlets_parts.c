@@ -83,14 +83,8 @@ size_t sp_meshlet_plan_close_parts(sp_meshlet_context* ctx, sp_meshlet_plan* pla
         if (part_start[r] == UINT32_MAX) /* not a root, or a part too large or too small */
             continue;
         const uint32_t* part = list + part_start[r];
-        int fits = 1;
-        for (uint32_t k = 0; k < part_fill[r] && fits; ++k) {
-            fits = sp_meshlet_fits(ctx, part[k]); /* the palette cap: a part may need more joints */
-            if (fits)
-                sp_meshlet_add(ctx, part[k]);
-        }
-        if (!fits) {
-            sp_meshlet_reset_open(ctx); /* growth cuts it */
+        if (!sp_meshlet_add_triangles(ctx, part, part_fill[r], 1)) {
+            sp_meshlet_reset_open(ctx); /* the palette cap: a part may need more joints; growth cuts it */
             continue;
         }
         for (uint32_t k = 0; k < part_fill[r]; ++k)

@@ -122,12 +122,7 @@ static int gain_in(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, uint32_
 {
     load(ctx, plan, b);
     uint32_t before = ctx->open_joint_count;
-    int fit = 1;
-    for (uint32_t i = 0; i < count && fit; ++i) {
-        fit = sp_meshlet_fits(ctx, triangles[i]);
-        if (fit)
-            sp_meshlet_add(ctx, triangles[i]);
-    }
+    int fit = sp_meshlet_add_triangles(ctx, triangles, count, 1);
     int gained = (int)(ctx->open_joint_count - before);
     sp_meshlet_reset_open(ctx);
     return fit ? gained : -1;

@@ -567,83 +567,101 @@ static uint32_t next_seed(const sp_meshlet_context* ctx, skin_state* s)
     return (uint32_t)s->morton[s->seed_cursor];
 }
 
-void sp_meshlets_build_skin(sp_meshlet_context* ctx)
+/* Carves the builder's arrays from its scratch and fills the per-mesh ones (adjacency, tuple ids,
+ * influence bands, spatial order); returns the scratch left over, which the steps after growth
+ * take in turn. */
+static unsigned char* init_state(sp_meshlet_context* ctx, skin_state* s)
 {
     unsigned char* cursor = ctx->builder_scratch;
     size_t t_count = ctx->triangle_count, v_count = ctx->vertex_count;
-    skin_state s;
-    s.adjacency_offset = sp_meshlet_carve(&cursor, (v_count + 1) * sizeof(uint32_t));
-    s.adjacency = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(uint32_t));
-    s.live = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
-    s.emitted = sp_meshlet_carve(&cursor, t_count);
-    s.centroid = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(float));
-    s.morton = sp_meshlet_carve(&cursor, t_count * sizeof(uint64_t));
-    s.rank = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
-    s.seed_cursor = 0;
-    s.last_rank = 0;
-    s.vertex_tuple = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
+    s->adjacency_offset = sp_meshlet_carve(&cursor, (v_count + 1) * sizeof(uint32_t));
+    s->adjacency = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(uint32_t));
+    s->live = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
+    s->emitted = sp_meshlet_carve(&cursor, t_count);
+    s->centroid = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(float));
+    s->morton = sp_meshlet_carve(&cursor, t_count * sizeof(uint64_t));
+    s->rank = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
+    s->seed_cursor = 0;
+    s->last_rank = 0;
+    s->vertex_tuple = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
     size_t tuple_slots = sp_meshlet_tuple_set_slots(v_count);
-    s.tuple_stamp = sp_meshlet_carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
+    s->tuple_stamp = sp_meshlet_carve(&cursor, (tuple_slots + 1) * sizeof(uint32_t));
     uint64_t* tuple_set = sp_meshlet_carve(&cursor, tuple_slots * sizeof(uint64_t));
-    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, tuple_set, s.vertex_tuple);
-    memset(s.tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
-    s.open_stamp = 1;
-    s.open_tuple_count = 0;
-    s.seed_count = 0;
-    s.centroid_sum[0] = s.centroid_sum[1] = s.centroid_sum[2] = 0.0f;
-    s.influences = sp_meshlet_carve(&cursor, v_count);
-    s.open_band = 0;
-    s.open_border = 0;
-    sp_meshlet_plan_init(&s.plan, &cursor, t_count);
-    memset(s.emitted, 0, t_count);
-    build_adjacency(ctx, &s);
-    s.regular = is_regular(ctx, &s);
-    s.banded = 0;
-    if (s.regular)
-        count_influences(ctx, &s);
-    build_spatial_order(ctx, &s);
-    size_t packed = sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted);
+    ctx->global_tuples = sp_meshlet_tuple_ids(ctx, tuple_set, s->vertex_tuple);
+    memset(s->tuple_stamp, 0, (tuple_slots + 1) * sizeof(uint32_t));
+    s->open_stamp = 1;
+    s->open_tuple_count = 0;
+    s->seed_count = 0;
+    s->centroid_sum[0] = s->centroid_sum[1] = s->centroid_sum[2] = 0.0f;
+    s->influences = sp_meshlet_carve(&cursor, v_count);
+    s->open_band = 0;
+    s->open_border = 0;
+    sp_meshlet_plan_init(&s->plan, &cursor, t_count);
+    memset(s->emitted, 0, t_count);
+    build_adjacency(ctx, s);
+    s->regular = is_regular(ctx, s);
+    s->banded = 0;
+    if (s->regular)
+        count_influences(ctx, s);
+    build_spatial_order(ctx, s);
+    return cursor;
+}
 
-    for (size_t done = packed; done < t_count; ++done) {
-        if (ctx->open_triangle_count == 0) {
-            emit(ctx, &s, next_seed(ctx, &s));
-            continue;
-        }
-        candidate fitting = best_neighbour(ctx, &s, 1);
-        if (fitting.triangle != NO_TRIANGLE) {
-            emit(ctx, &s, fitting.triangle);
-            continue;
-        }
-        candidate any = best_neighbour(ctx, &s, 0);
-        if (any.triangle != NO_TRIANGLE) {
-            /* the patch goes on but the meshlet is full: the next meshlet starts at the least
-             * enclosed border seed (so no sliver is stranded), else where this one stopped */
-            flush(ctx, &s);
-            uint32_t next = pick_seed(ctx, &s);
-            emit(ctx, &s, next != NO_TRIANGLE ? next : any.triangle);
-            continue;
-        }
-        /* the surface patch is used up: jump to the nearest free triangle, into this meshlet if
-         * it has room for one more disconnected triangle (3 new vertices), else into the next */
-        float point[3];
-        open_centroid(ctx, &s, point);
-        uint32_t near = NO_TRIANGLE;
-        if (ctx->open_vertex_count + 3 <= ctx->options.max_vertices &&
-            ctx->open_triangle_count < ctx->options.max_triangles)
-            near = nearest_free(ctx, &s, point, 1);
-        if (near == NO_TRIANGLE) {
-            flush(ctx, &s);
-            near = nearest_free(ctx, &s, point, 0);
-        }
-        emit(ctx, &s, near != NO_TRIANGLE ? near : next_seed(ctx, &s));
+/* The surface patch is used up: jump to the nearest free triangle, into the open meshlet if it
+ * has room for one more disconnected triangle, else into the next. */
+static void jump(sp_meshlet_context* ctx, skin_state* s)
+{
+    float point[3];
+    open_centroid(ctx, s, point);
+    uint32_t near = NO_TRIANGLE;
+    if (sp_meshlet_triangle_room(&ctx->options, ctx->open_vertex_count, ctx->open_triangle_count))
+        near = nearest_free(ctx, s, point, 1);
+    if (near == NO_TRIANGLE) {
+        flush(ctx, s);
+        near = nearest_free(ctx, s, point, 0);
     }
-    sp_meshlet_plan_close(ctx, &s.plan);
+    emit(ctx, s, near != NO_TRIANGLE ? near : next_seed(ctx, s));
+}
+
+/* Grows meshlets over the triangles that the parts step left (it took `done`) and closes them
+ * into the plan. */
+static void grow(sp_meshlet_context* ctx, skin_state* s, size_t done)
+{
+    for (; done < ctx->triangle_count; ++done) {
+        if (ctx->open_triangle_count == 0) {
+            emit(ctx, s, next_seed(ctx, s));
+            continue;
+        }
+        candidate fitting = best_neighbour(ctx, s, 1);
+        if (fitting.triangle != NO_TRIANGLE) {
+            emit(ctx, s, fitting.triangle);
+            continue;
+        }
+        candidate any = best_neighbour(ctx, s, 0);
+        if (any.triangle == NO_TRIANGLE) {
+            jump(ctx, s);
+            continue;
+        }
+        /* the patch goes on but the meshlet is full: the next meshlet starts at the least
+         * enclosed border seed (so no sliver is stranded), else where this one stopped */
+        flush(ctx, s);
+        uint32_t next = pick_seed(ctx, s);
+        emit(ctx, s, next != NO_TRIANGLE ? next : any.triangle);
+    }
+    sp_meshlet_plan_close(ctx, &s->plan);
+}
+
+void sp_meshlets_build_skin(sp_meshlet_context* ctx)
+{
+    skin_state s;
+    unsigned char* cursor = init_state(ctx, &s);
+    grow(ctx, &s, sp_meshlet_plan_close_parts(ctx, &s.plan, s.adjacency_offset, cursor, s.emitted));
     sp_meshlet_plan_pack(ctx, &s.plan, cursor);
     sp_meshlet_plan_merge(ctx, &s.plan, s.rank);
     sp_meshlet_plan_link(&s.plan);
     sp_meshlet_plan_refine(ctx, &s.plan, s.adjacency_offset, s.adjacency);
     /* live as the exchange step's zeroed vertex scratch (the parts closed whole never left it) */
-    memset(s.live, 0, v_count * sizeof(uint32_t));
+    memset(s.live, 0, ctx->vertex_count * sizeof(uint32_t));
     sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live);
     sp_meshlet_plan_write(ctx, &s.plan);
 }
