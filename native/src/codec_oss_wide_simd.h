@@ -423,8 +423,10 @@ SP_INLINE SIMD_FN vec wide_biased_row(vec apex, vec mirrored)
  * then is w's row or next to it, |i| below two rows' lengths, 2^25): so the layer is checked
  * first, in double (wide_layer_outside), and a rest outside it sent to the scalar code with
  * whatever the 32-bit lanes made of it. Then, as in decode_chunk, a rest in the layer that the
- * row check accepts proves (k, j, i).
+ * row check accepts proves (k, j, i). The stages, in order: wide_layer_start, the layer root's
+ * finish, wide_biased_rest and the row estimate, the 32-bit lanes (wide_decode_pairs).
  */
+
 /* The first stage of K = 4's wide decode over `blocks` blocks: each block's codes checked, their
  * halves (v_halves), or with `whole` (codes below WIDE_WHOLE_CODES) the codes themselves in low,
  * the layer root's argument and its float start (root_start_pair: ~5% faster on AVX2 than one by
@@ -466,6 +468,7 @@ SP_INLINE SIMD_FN int wide_decode_pairs(const sp_codec* codec, const void* const
                                         float* weights, uint32_t k, const simd_layout* layout, int whole)
 {
     const wide_codec* c = (const wide_codec*)constants;
+    double scale = (double)codec->scale; /* a local: the weights' stores could alias *codec, so it would be read again each pair */
     vec x[WIDE_CHUNK4], layer[WIDE_CHUNK4], biased[WIDE_CHUNK4], row[WIDE_CHUNK4];
     vec high[WIDE_CHUNK4], low[WIDE_CHUNK4]; /* the codes' 32-bit halves, or the whole codes in low */
     root z[WIDE_CHUNK4];
@@ -490,7 +493,7 @@ SP_INLINE SIMD_FN int wide_decode_pairs(const sp_codec* codec, const void* const
         nint i = n_row_offset(bottom, j, i_low_pair(biased[2 * p], biased[2 * p + 1]), &last);
         any |= missed[p] = n_outside(i, last) | outside[2 * p] | outside[2 * p + 1] << BLOCK;
         n_components(c->n, 4, layers, j, i, q);
-        store_quotients32(q, k, (double)codec->scale, layout, weights + p * NBLOCK * k);
+        store_quotients32(q, k, scale, layout, weights + p * NBLOCK * k);
     }
     if (any) redo_decode(codec, codes, pairs, NBLOCK, missed, k, weights); /* most chunks have none */
     return 1;
