@@ -101,8 +101,8 @@ def write_element_weights(mesh, counts, weights, current):
         elements.foreach_set("weight", weights[starts[index]:ends[index]])
 
 
-def gather(obj):
-    """Reads obj's deform weights; raises GatherError with a clear message on invalid input."""
+def checked_armature(obj):
+    """The armature deforming obj and its deform bone names; GatherError where there is none."""
     name = obj.name if obj else "<none>"
     if obj is None or obj.type != 'MESH':
         raise GatherError("%s is not a mesh" % name)
@@ -115,6 +115,47 @@ def gather(obj):
     if len(joint_names) > native.SP_MAX_JOINTS:
         raise GatherError("%s: armature %s has %d deform bones, more than the supported %d"
                           % (name, armature.name, len(joint_names), native.SP_MAX_JOINTS))
+    return armature, joint_names
+
+
+def check_influences(name, armature, deform, weights, vertex_of, vertex_count):
+    """The used elements (deform, weight > 0) and each vertex's count of them; GatherError for
+    non-finite or negative deform weights and for vertices with no influence."""
+    bad = deform & ~np.isfinite(weights)
+    if bad.any():
+        raise GatherError("%s: %d vertices have non-finite (NaN or infinite) weights"
+                          % (name, len(np.unique(vertex_of[bad]))))
+    bad = deform & (weights < 0)
+    if bad.any():
+        raise GatherError("%s: %d vertices have negative weights" % (name, len(np.unique(vertex_of[bad]))))
+    # Zero weights are not influences (the exporter drops them too).
+    used = deform & (weights > 0)
+    influence_count = np.bincount(vertex_of[used], minlength=vertex_count)
+    unweighted = int((influence_count == 0).sum())
+    if unweighted:
+        raise GatherError("%s: %d of %d vertices have no weight on a deform bone of %s (assign them, "
+                          "e.g. Weight Paint or Automatic Weights)" % (name, unweighted, vertex_count, armature.name))
+    return used, influence_count
+
+
+def dense_influences(result, used, joints, weights, vertex_of, influence_count):
+    """result.joints / result.weights as dense (V, stride) arrays, stride the most influences a
+    vertex has: every influence goes to the library, which keeps the K strongest and reports the
+    pruning. Slot = rank of the element among its vertex's used elements."""
+    vertex_count, stride = len(influence_count), int(influence_count.max())
+    used_vertices = vertex_of[used]
+    starts = np.concatenate(([0], np.cumsum(influence_count)[:-1]))
+    slots = np.arange(len(used_vertices)) - starts[used_vertices]
+    result.joints = np.zeros((vertex_count, stride), dtype=np.uint16)
+    result.weights = np.zeros((vertex_count, stride), dtype=np.float32)
+    result.joints[used_vertices, slots] = joints[used]
+    result.weights[used_vertices, slots] = weights[used]
+
+
+def gather(obj):
+    """Reads obj's deform weights; raises GatherError with a clear message on invalid input."""
+    armature, joint_names = checked_armature(obj)
+    name = obj.name
     joint_of_name = {bone: index for index, bone in enumerate(joint_names)}
     group_to_joint = np.array([joint_of_name.get(g.name, -1) for g in obj.vertex_groups] + [-1], dtype=np.int64)
     if not (group_to_joint[:-1] >= 0).any():
@@ -135,34 +176,8 @@ def gather(obj):
     joints = group_to_joint[safe_groups]
     result.element_joints = joints
     vertex_of = np.repeat(np.arange(vertex_count), counts)
-
-    deform = joints >= 0
-    bad = deform & ~np.isfinite(weights)
-    if bad.any():
-        raise GatherError("%s: %d vertices have non-finite (NaN or infinite) weights"
-                          % (name, len(np.unique(vertex_of[bad]))))
-    bad = deform & (weights < 0)
-    if bad.any():
-        raise GatherError("%s: %d vertices have negative weights" % (name, len(np.unique(vertex_of[bad]))))
-
-    # Zero weights are not influences (the exporter drops them too).
-    used = deform & (weights > 0)
-    influence_count = np.bincount(vertex_of[used], minlength=vertex_count)
-    unweighted = int((influence_count == 0).sum())
-    if unweighted:
-        raise GatherError("%s: %d of %d vertices have no weight on a deform bone of %s (assign them, "
-                          "e.g. Weight Paint or Automatic Weights)" % (name, unweighted, vertex_count, armature.name))
-    # Every influence goes to the library, which keeps the K strongest and reports the pruning.
-    stride = int(influence_count.max())
-
-    # Dense (V, stride) arrays: slot = rank of the element among its vertex's used elements.
-    used_vertices = vertex_of[used]
-    starts = np.concatenate(([0], np.cumsum(influence_count)[:-1]))
-    slots = np.arange(len(used_vertices)) - starts[used_vertices]
-    result.joints = np.zeros((vertex_count, stride), dtype=np.uint16)
-    result.weights = np.zeros((vertex_count, stride), dtype=np.float32)
-    result.joints[used_vertices, slots] = joints[used]
-    result.weights[used_vertices, slots] = weights[used]
+    used, influence_count = check_influences(name, armature, joints >= 0, weights, vertex_of, vertex_count)
+    dense_influences(result, used, joints, weights, vertex_of, influence_count)
     return result
 
 

@@ -242,6 +242,45 @@ static void narrow(const bench_options* o, bench_buffers* b, uint32_t k)
     }
 }
 
+/* The run's header: the machine's rates as a JSON object's head, or as text lines. */
+static void print_header(const bench_options* o, sp_isa isa, sp_isa cpu, double copy, bench_rate lut, size_t lut_size)
+{
+    if (o->json) {
+        printf("{\"vertices\": %zu, \"repeats\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
+               "\"memcpy_bytes_per_vertex\": %d, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
+               "\"lut_build_ratio\": %.3f, \"lut_size\": %zu, \"codecs\": [",
+               o->count, o->repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut.per_s, lut.ratio,
+               lut_size);
+        return;
+    }
+    printf("skinpack bench: %zu vertices, single thread, median of %d, vector path %s (CPU: %s)\n", o->count,
+           o->repeats, isa_names[isa], isa_names[cpu]);
+    printf("memcpy (16 B/vertex)  %8.1f M vertices/s\n", copy / 1e6);
+    printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut.per_s / 1e6, lut.ratio,
+           lut_size);
+    printf("%-6s %2s %4s  %10s %7s %7s  %10s %7s %7s\n", "method", "K", "bits", "encode M/s", "ratio", "best",
+           "decode M/s", "ratio", "best");
+}
+
+/* One codec's row (JSON: `first` says whether a comma goes before it). */
+static void print_row(const bench_options* o, const sp_codec* codec, uint32_t budget, int vector, bench_rate enc,
+                      bench_rate dec, int first)
+{
+    const char* name = sp_method_name(codec->method);
+    if (o->json)
+        printf("%s{\"method\": \"%s\", \"influences\": %u, \"budget\": %u, \"bits\": %u, "
+               "\"encode_vector\": %s, \"decode_vector\": %s, "
+               "\"encode_vertices_per_s\": %.0f, \"decode_vertices_per_s\": %.0f, "
+               "\"encode_ratio\": %.3f, \"decode_ratio\": %.3f, \"encode_best_ratio\": %.3f, "
+               "\"decode_best_ratio\": %.3f}",
+               first ? "" : ", ", name, codec->influences, budget, codec->bits, vector ? "true" : "false",
+               vector ? "true" : "false", enc.per_s, dec.per_s, enc.ratio, dec.ratio, enc.best_ratio, dec.best_ratio);
+    else
+        printf("%-6s %2u %4u  %10.1f %6.3fx %6.3fx  %10.1f %6.3fx %6.3fx%s\n", name, codec->influences, codec->bits,
+               enc.per_s / 1e6, enc.ratio, enc.best_ratio, dec.per_s / 1e6, dec.ratio, dec.best_ratio,
+               vector ? "" : "  (scalar)");
+}
+
 int skinpack_cmd_bench(int argc, char** argv)
 {
     bench_options o;
@@ -258,22 +297,7 @@ int skinpack_cmd_bench(int argc, char** argv)
     double copy = memcpy_rate(&o, &b);
     size_t lut_size = 0;
     bench_rate lut = lut_rate(&o, &b, &lut_size);
-
-    if (o.json)
-        printf("{\"vertices\": %zu, \"repeats\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
-               "\"memcpy_bytes_per_vertex\": %d, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
-               "\"lut_build_ratio\": %.3f, \"lut_size\": %zu, \"codecs\": [",
-               o.count, o.repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut.per_s, lut.ratio,
-               lut_size);
-    else {
-        printf("skinpack bench: %zu vertices, single thread, median of %d, vector path %s (CPU: %s)\n", o.count,
-               o.repeats, isa_names[isa], isa_names[cpu]);
-        printf("memcpy (16 B/vertex)  %8.1f M vertices/s\n", copy / 1e6);
-        printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut.per_s / 1e6, lut.ratio,
-               lut_size);
-        printf("%-6s %2s %4s  %10s %7s %7s  %10s %7s %7s\n", "method", "K", "bits", "encode M/s", "ratio", "best",
-               "decode M/s", "ratio", "best");
-    }
+    print_header(&o, isa, cpu, copy, lut, lut_size);
     int first = 1;
     static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
     for (uint32_t k = 2; k <= 4; ++k) {
@@ -284,21 +308,7 @@ int skinpack_cmd_bench(int argc, char** argv)
                 bench_rate enc, dec;
                 if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
                 codec_rates(&o, &b, &codec, &enc, &dec);
-                int vector = m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, isa);
-                if (o.json)
-                    printf("%s{\"method\": \"%s\", \"influences\": %u, \"budget\": %u, \"bits\": %u, "
-                           "\"encode_vector\": %s, \"decode_vector\": %s, "
-                           "\"encode_vertices_per_s\": %.0f, \"decode_vertices_per_s\": %.0f, "
-                           "\"encode_ratio\": %.3f, \"decode_ratio\": %.3f, \"encode_best_ratio\": %.3f, "
-                           "\"decode_best_ratio\": %.3f}",
-                           first ? "" : ", ", sp_method_name((sp_method)m), k, budgets[i], codec.bits,
-                           vector ? "true" : "false", vector ? "true" : "false", enc.per_s, dec.per_s,
-                           enc.ratio, dec.ratio, enc.best_ratio, dec.best_ratio);
-                else
-                    printf("%-6s %2u %4u  %10.1f %6.3fx %6.3fx  %10.1f %6.3fx %6.3fx%s\n", sp_method_name((sp_method)m), k,
-                           codec.bits, enc.per_s / 1e6, enc.ratio, enc.best_ratio, dec.per_s / 1e6, dec.ratio,
-                           dec.best_ratio,
-                           vector ? "" : "  (scalar)");
+                print_row(&o, &codec, budgets[i], m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, isa), enc, dec, first);
                 first = 0;
             }
     }

@@ -120,6 +120,45 @@ static void narrow_influences(uint16_t* joints, float* weights, size_t vertex_co
         }
 }
 
+/* The option checks of sp_compress_skin: exactly one budget, finite limits, K in range. */
+static int compress_options_valid(const sp_compress_options* options)
+{
+    int budgets = (options->vertex_bits != 0) + (options->weight_bits != 0) + (options->max_spacing > 0) +
+                  (options->max_error > 0);
+    return budgets == 1 && options->max_error >= 0 && options->max_spacing >= 0 && options->max_influences >= 1 &&
+           options->max_influences <= SP_MAX_INFLUENCES;
+}
+
+/* The codec of the options' budget, and the codes and tuple table of w under it. */
+static sp_result quantise_for_budget(skin_work* w, const sp_compress_options* options, sp_codec* codec,
+                                     size_t* lut_size)
+{
+    if (options->vertex_bits) return fit_vertex_budget(w, options, codec, lut_size);
+    sp_result r;
+    if (options->weight_bits) r = sp_codec_from_bits(options->method, w->k, options->weight_bits, codec);
+    else if (options->max_error > 0) r = sp_codec_from_max_error(options->method, w->k, options->max_error, codec);
+    else r = sp_codec_from_spacing(options->method, w->k, options->max_spacing, codec);
+    return r == SP_OK ? quantise_and_index(w, codec, lut_size) : r;
+}
+
+/* The sizes and bit counts of a finished compression into result (its prepare and
+ * quantization statistics are already there). */
+static void fill_compressed(sp_compressed_skin* result, const sp_codec* codec, uint32_t k, uint32_t tuple_bits,
+                            size_t vertex_count, size_t joint_count, size_t lut_size)
+{
+    result->codec = *codec;
+    result->influences = k;
+    result->tuple_bits = tuple_bits;
+    result->weight_bits = codec->bits;
+    result->words_per_vertex = sp_words_per_vertex(tuple_bits, codec->bits);
+    result->joint_bytes = joint_count <= 256 ? 1 : 2;
+    result->vertex_count = vertex_count;
+    result->joint_count = joint_count;
+    result->lut_size = lut_size;
+    result->lut_bits_per_vertex = (double)lut_size * k * 8.0 * result->joint_bytes / (double)vertex_count;
+    result->bits_per_vertex = tuple_bits + codec->bits + result->lut_bits_per_vertex;
+}
+
 sp_result sp_compress_skin(const uint16_t* joints, const float* weights, size_t vertex_count, size_t input_stride,
                            size_t joint_count, const sp_compress_options* options, uint32_t* words, uint16_t* lut,
                            float* per_vertex_error, float* per_vertex_pruning, sp_compressed_skin* result,
@@ -127,10 +166,7 @@ sp_result sp_compress_skin(const uint16_t* joints, const float* weights, size_t 
 {
     if (!options || !result || !words || !lut || vertex_count == 0) return SP_ERR_INVALID_ARGUMENT;
     memset(result, 0, sizeof(*result));
-    int budgets = (options->vertex_bits != 0) + (options->weight_bits != 0) + (options->max_spacing > 0) +
-                  (options->max_error > 0);
-    if (budgets != 1 || !(options->max_error >= 0) || !(options->max_spacing >= 0)) return SP_ERR_INVALID_ARGUMENT;
-    if (options->max_influences < 1 || options->max_influences > SP_MAX_INFLUENCES) return SP_ERR_INVALID_ARGUMENT;
+    if (!compress_options_valid(options)) return SP_ERR_INVALID_ARGUMENT;
     scratch_layout l = layout_scratch(vertex_count);
     if (!scratch || scratch_size < l.total) return SP_ERR_BUFFER_TOO_SMALL;
     if (((uintptr_t)scratch & 7) != 0) return SP_ERR_INVALID_ARGUMENT;
@@ -151,34 +187,14 @@ sp_result sp_compress_skin(const uint16_t* joints, const float* weights, size_t 
                    options->merge_dont_care};
     size_t lut_size = 0;
     sp_codec codec;
-    if (options->vertex_bits) {
-        r = fit_vertex_budget(&w, options, &codec, &lut_size);
-    } else {
-        if (options->weight_bits) r = sp_codec_from_bits(options->method, k, options->weight_bits, &codec);
-        else if (options->max_error > 0) r = sp_codec_from_max_error(options->method, k, options->max_error, &codec);
-        else r = sp_codec_from_spacing(options->method, k, options->max_spacing, &codec);
-        if (r == SP_OK) r = quantise_and_index(&w, &codec, &lut_size);
-    }
-    if (r != SP_OK) return r;
-
+    if ((r = quantise_for_budget(&w, options, &codec, &lut_size)) != SP_OK) return r;
     uint32_t tuple_bits = sp_index_bits(lut_size);
     if ((r = sp_pack_vertices(w.tuple_index, w.codes, vertex_count, tuple_bits, codec.bits, words)) != SP_OK)
         return r;
     r = sp_measure_weight_errors(&codec, prepared_weights, w.codes, vertex_count, per_vertex_error,
                                  &result->quantization);
     if (r != SP_OK) return r;
-
-    result->codec = codec;
-    result->influences = k;
-    result->tuple_bits = tuple_bits;
-    result->weight_bits = codec.bits;
-    result->words_per_vertex = sp_words_per_vertex(tuple_bits, codec.bits);
-    result->joint_bytes = joint_count <= 256 ? 1 : 2;
-    result->vertex_count = vertex_count;
-    result->joint_count = joint_count;
-    result->lut_size = lut_size;
-    result->lut_bits_per_vertex = (double)lut_size * k * 8.0 * result->joint_bytes / (double)vertex_count;
-    result->bits_per_vertex = tuple_bits + codec.bits + result->lut_bits_per_vertex;
+    fill_compressed(result, &codec, k, tuple_bits, vertex_count, joint_count, lut_size);
     return SP_OK;
 }
 
