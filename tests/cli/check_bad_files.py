@@ -10,6 +10,7 @@ reason contains the expected words, and leaves neither OUT nor a temporary file 
 import argparse
 import copy
 import glob
+import json
 import os
 import struct
 import subprocess
@@ -254,36 +255,24 @@ def expect_failure(cmd, words, out, work):
     return problems
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--skinpack", required=True)
-    parser.add_argument("--work", required=True)
-    parser.add_argument("asset")
-    args = parser.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    out = os.path.join(args.work, "out.glb")
+def compressed(args, flags, name):
+    """The asset compressed with flags (compact), loaded: (document, binary)."""
+    path = os.path.join(args.work, name)
+    subprocess.run([args.skinpack, "compress", args.asset, "-o", path, "--compact"] + flags, check=True,
+                   capture_output=True)
+    return load(path)
+
+
+def edited_file_failures(args, out, document, binary):
+    """Every broken copy of the asset and of its compressed forms, refused by info and by
+    compress (standard copies) or decompress (packed ones)."""
+    packed = compressed(args, ["--vertex-bits", "32"], "packed.glb")
+    meshlets = compressed(args, ["--meshlets"], "packed_meshlets.glb")
+    meshopt = compressed(args, ["--meshopt"], "packed_meshopt.glb")
+    cases = [("standard", c, document, binary) for c in STANDARD] + [("packed", c) + packed for c in PACKED]
+    cases += [("meshlets", c) + meshlets for c in MESHLETS]
+    cases += [("meshopt", c) + meshopt for c in meshopt_cases(meshopt[0])]
     failures = []
-
-    document, binary = load(args.asset)
-    packed_path = os.path.join(args.work, "packed.glb")
-    subprocess.run([args.skinpack, "compress", args.asset, "-o", packed_path, "--compact", "--vertex-bits", "32"],
-                   check=True, capture_output=True)
-    packed_document, packed_binary = load(packed_path)
-
-    meshlets_path = os.path.join(args.work, "packed_meshlets.glb")
-    subprocess.run([args.skinpack, "compress", args.asset, "-o", meshlets_path, "--compact", "--meshlets"],
-                   check=True, capture_output=True)
-    meshlets_document, meshlets_binary = load(meshlets_path)
-
-    meshopt_path = os.path.join(args.work, "packed_meshopt.glb")
-    subprocess.run([args.skinpack, "compress", args.asset, "-o", meshopt_path, "--compact", "--meshopt"],
-                   check=True, capture_output=True)
-    meshopt_document, meshopt_binary = load(meshopt_path)
-
-    cases = [("standard", c, document, binary) for c in STANDARD] + [("packed", c, packed_document, packed_binary)
-                                                                      for c in PACKED]
-    cases += [("meshlets", c, meshlets_document, meshlets_binary) for c in MESHLETS]
-    cases += [("meshopt", c, meshopt_document, meshopt_binary) for c in meshopt_cases(meshopt_document)]
     for kind, (name, words, edit), doc, data in cases:
         d, b = copy.deepcopy(doc), bytearray(data)
         edit(d, b)
@@ -295,8 +284,13 @@ def main():
         for cmd in commands:
             problems = expect_failure(cmd, words, out if "-o" in cmd else None, args.work)
             failures += ["%s: %s" % (name, p) for p in problems]
+    return failures
 
-    # Files that are not glTF at all, or cut short.
+
+def unreadable_file_failures(args, out, document, binary):
+    """Files that are not glTF at all or cut short, a .gltf whose buffer file is missing, and a
+    folder in place of a file (it used to abort with an uncaught C++ exception)."""
+    failures = []
     with open(args.asset, "rb") as f:
         whole = f.read()
     for name, data, words in [("truncated", whole[: len(whole) // 2], "glTF"), ("empty", b"", "too small"),
@@ -307,39 +301,52 @@ def main():
         for cmd in ([args.skinpack, "info", path], [args.skinpack, "compress", path, "-o", out]):
             failures += ["%s: %s" % (name, p) for p in expect_failure(cmd, words, out, args.work)]
 
-    # A .gltf whose buffer file is missing.
     missing = copy.deepcopy(document)
     missing["buffers"] = [{"byteLength": len(binary), "uri": "missing.bin"}]
     path = os.path.join(args.work, "missing-buffer.gltf")
     with open(path, "w") as f:
-        import json
         json.dump(missing, f)
     failures += ["missing-buffer: %s" % p for p in
                  expect_failure([args.skinpack, "compress", path, "-o", out], "missing.bin", out, args.work)]
 
-    # A folder instead of a file (it used to abort with an uncaught C++ exception).
     for command in ("info", "compress", "decompress"):
         cmd = [args.skinpack, command, args.work] + (["-o", out] if command != "info" else [])
         failures += ["folder: %s" % p for p in expect_failure(cmd, "is a folder", out if command != "info" else None,
                                                               args.work)]
+    return failures
 
-    # Option mistakes are reported as option errors, naming the option.
+
+def option_failures(args, out):
+    """Option mistakes are reported as option errors (exit 2), naming the option; an output
+    folder that does not exist is an error, with nothing half-written anywhere."""
+    failures = []
     for option, value in (("--weight-bits", "99"), ("--vertex-bits", "0"), ("--max-influences", "9"),
                           ("--method", "zip"), ("--max-error", "2")):
         cmd = [args.skinpack, "compress", args.asset, "-o", out, option, value]
         result = subprocess.run(cmd, capture_output=True, text=True)
         if result.returncode != 2 or option not in result.stderr or os.path.exists(out):
             failures.append("option %s %s: exit %d, %r" % (option, value, result.returncode, result.stderr.strip()))
-
-    # An output folder that does not exist: error, and nothing half-written anywhere.
     bad_out = os.path.join(args.work, "no-such-dir", "out.glb")
     failures += ["unwritable: %s" % p for p in
                  expect_failure([args.skinpack, "compress", args.asset, "-o", bad_out], "cannot", bad_out, args.work)]
+    return failures
 
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--skinpack", required=True)
+    parser.add_argument("--work", required=True)
+    parser.add_argument("asset")
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    out = os.path.join(args.work, "out.glb")
+    document, binary = load(args.asset)
+    failures = edited_file_failures(args, out, document, binary)
+    failures += unreadable_file_failures(args, out, document, binary)
+    failures += option_failures(args, out)
     if failures:
         print("\n".join(failures))
         raise SystemExit("%d problem(s)" % len(failures))
     print("OK")
-
 
 main()
