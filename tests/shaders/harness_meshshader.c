@@ -127,8 +127,7 @@ static SpMeshletOutputRecord* gpu_meshlet_outputs(harness* h, VkPipeline pipelin
 {
     vkx_context* ctx = &h->ctx;
     size_t record_count = (size_t)meshlet_count * instances;
-    vkx_buffer output = vkx_buffer_create(ctx, record_count * sizeof(SpMeshletOutputRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
-    memset(output.mapped, 0xcd, output.size);
+    vkx_buffer output = vkx_poisoned_buffer(ctx, record_count * sizeof(SpMeshletOutputRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer* bindings[SP_BINDING_COUNT];
     memcpy(bindings, inputs, sizeof(bindings));
     bindings[SP_BINDING_OUTPUT] = &output;
@@ -181,13 +180,13 @@ static void check_cone_is_conservative(harness* h, const sp_gpu_meshlets* built,
     }
 }
 
-/* Checks one record (meshlet m, instance i) against the C reference. */
-static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_t m, uint32_t instance,
-                                 const SpMeshletOutputRecord* r, const instance_reference* ref, const float* instance_rows,
-                                 const SpSkinParameters* params, cull_counts* counts)
+/* The record's normal-cone decision against C's, counted. Returns 0 when the record failed
+ * or the GPU culled the meshlet (nothing more to check). */
+static int check_record_cone(harness* h, const sp_gpu_meshlets* built, size_t m, uint32_t instance,
+                             const SpMeshletOutputRecord* r, const instance_reference* ref, const float* instance_rows,
+                             const SpSkinParameters* params, cull_counts* counts)
 {
     const sp_meshlet* meshlet = &built->arrays.meshlets[m];
-    const float* vp = params->view_projection.columns;
     int rigid;
     int cone = reference_cone_faces_away(meshlet, built->arrays.joints, instance_rows, params, instance, &rigid);
     int gpu_culled = r->counts.x == 0 && r->counts.y == 0;
@@ -197,15 +196,24 @@ static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_
     if (cone >= 0 && gpu_culled != cone) {
         fail_check(h, "meshlet %zu instance %u: the GPU %s it by its normal cone, C %s", m, instance,
                    gpu_culled ? "culled" : "kept", cone ? "culls" : "keeps");
-        return;
+        return 0;
     }
     if (cone == 1) check_cone_is_conservative(h, built, m, instance, ref);
-    if (gpu_culled) return;
+    if (gpu_culled) return 0;
     if (r->counts.x != meshlet->vertex_count || r->counts.y != meshlet->triangle_count) {
         fail_check(h, "meshlet %zu instance %u: outputs %u vertices, %u triangles; the meshlet has %u, %u", m, instance,
                    r->counts.x, r->counts.y, meshlet->vertex_count, meshlet->triangle_count);
-        return;
+        return 0;
     }
+    return 1;
+}
+
+/* The record's world and clip positions against C's. The clip tolerance is the world error
+ * carried through the matrix, plus a few float roundings of the product. */
+static void check_record_vertices(harness* h, const sp_gpu_meshlets* built, size_t m, uint32_t instance,
+                                  const SpMeshletOutputRecord* r, const instance_reference* ref, const float* vp)
+{
+    const sp_meshlet* meshlet = &built->arrays.meshlets[m];
     for (uint32_t i = 0; i < meshlet->vertex_count; ++i) {
         uint32_t v = built->arrays.vertices[meshlet->vertex_offset + i];
         const double* world = ref->world + 3 * (size_t)v;
@@ -215,7 +223,6 @@ static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_
         double world_error = 0, clip_error = 0, clip_tolerance = 0;
         for (int c = 0; c < 3; ++c) world_error = fmax(world_error, fabs(got_world[c] - world[c]));
         for (int row = 0; row < 4; ++row) {
-            /* the world error carried through the matrix, plus a few float roundings of the product */
             double reach = fabs(vp[12 + row]), spread = 0;
             for (int c = 0; c < 3; ++c) {
                 reach += fabs(vp[4 * c + row] * world[c]);
@@ -229,6 +236,13 @@ static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_
             fail_check(h, "meshlet %zu instance %u vertex %u (source %u): world off by %.3g (tolerance %.3g), clip by %.3g (%.3g)",
                        m, instance, i, v, world_error, ref->world_tolerance, clip_error, clip_tolerance);
     }
+}
+
+/* The record's triangle corners and cull flags against C's, counted. */
+static void check_record_triangles(harness* h, const sp_gpu_meshlets* built, size_t m, uint32_t instance,
+                                   const SpMeshletOutputRecord* r, const instance_reference* ref, cull_counts* counts)
+{
+    const sp_meshlet* meshlet = &built->arrays.meshlets[m];
     for (uint32_t t = 0; t < meshlet->triangle_count; ++t) {
         const uint8_t* local = built->arrays.triangles + 3 * ((size_t)meshlet->triangle_offset + t);
         const uint32_t* got = &r->triangles[t].x;
@@ -249,6 +263,16 @@ static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_
             fail_check(h, "meshlet %zu instance %u triangle %u: the GPU %s it, C %s it", m, instance, t,
                        got[3] ? "culled" : "kept", culled ? "culls" : "keeps");
     }
+}
+
+/* Checks one record (meshlet m, instance i) against the C reference. */
+static void check_meshlet_record(harness* h, const sp_gpu_meshlets* built, size_t m, uint32_t instance,
+                                 const SpMeshletOutputRecord* r, const instance_reference* ref, const float* instance_rows,
+                                 const SpSkinParameters* params, cull_counts* counts)
+{
+    if (!check_record_cone(h, built, m, instance, r, ref, instance_rows, params, counts)) return;
+    check_record_vertices(h, built, m, instance, r, ref, params->view_projection.columns);
+    check_record_triangles(h, built, m, instance, r, ref, counts);
 }
 
 /* RE_Player has no rigid meshlet (every meshlet has several palette joints), so skin.mesh's
@@ -274,15 +298,62 @@ static uint16_t most_moved_joint(const sp_skin_mesh* mesh)
     return best;
 }
 
+enum { CAP_VERTICES = 1 + CAP_RINGS * CAP_SEGMENTS, CAP_TRIANGLES = CAP_SEGMENTS + 2 * CAP_SEGMENTS * (CAP_RINGS - 1) };
+
+/* A point of a cap: its apex (i = 0), then ring after ring of CAP_SEGMENTS points. */
+static void cap_point(uint32_t i, const float center[3], float radius, const float normal[3], const float u[3],
+                      const float w[3], float* out)
+{
+    const double half_angle = 50.0 * 3.14159265358979 / 180.0;
+    uint32_t ring = i == 0 ? 0 : 1 + (i - 1) / CAP_SEGMENTS, segment = i == 0 ? 0 : (i - 1) % CAP_SEGMENTS;
+    double polar = half_angle * ring / CAP_RINGS, azimuth = 6.283185307179586 * segment / CAP_SEGMENTS;
+    for (int c = 0; c < 3; ++c)
+        out[c] = center[c] + radius * (float)(cos(polar) * normal[c] + sin(polar) * (cos(azimuth) * u[c] + sin(azimuth) * w[c]));
+}
+
+/* Cap number `cap` (axis +-x, +-y, +-z): its sphere sits one box size outside the box
+ * [low, high] on that side. Writes its vertices, bound to joint, and returns index advanced
+ * past its triangles. */
+static uint32_t* add_cap(sp_skin_mesh* caps, uint32_t cap, const float low[3], const float high[3], uint16_t joint,
+                         uint32_t* index)
+{
+    float size = fmaxf(high[0] - low[0], fmaxf(high[1] - low[1], high[2] - low[2])), radius = 0.1f * size;
+    int axis = (int)cap / 2;
+    float sign = cap % 2 ? -1.0f : 1.0f, normal[3] = {0, 0, 0}, center[3];
+    normal[axis] = sign;
+    for (int c = 0; c < 3; ++c) center[c] = 0.5f * (low[c] + high[c]);
+    center[axis] = (sign > 0 ? high[axis] : low[axis]) + sign * size;
+    /* tangents u, w with u x w = normal, so counter-clockwise triangles face outwards */
+    float u[3] = {0, 0, 0}, w[3];
+    u[(axis + 1) % 3] = 1;
+    w[0] = normal[1] * u[2] - normal[2] * u[1];
+    w[1] = normal[2] * u[0] - normal[0] * u[2];
+    w[2] = normal[0] * u[1] - normal[1] * u[0];
+    uint32_t first = cap * CAP_VERTICES;
+    for (uint32_t i = 0; i < CAP_VERTICES; ++i) {
+        cap_point(i, center, radius, normal, u, w, caps->positions + 3 * (first + i));
+        caps->joints[8 * (size_t)(first + i)] = joint;
+        caps->weights[8 * (size_t)(first + i)] = 1.0f;
+    }
+    for (uint32_t s = 0; s < CAP_SEGMENTS; ++s) {
+        uint32_t next = (s + 1) % CAP_SEGMENTS;
+        *index++ = first, *index++ = first + 1 + s, *index++ = first + 1 + next;
+        for (uint32_t ring = 1; ring < CAP_RINGS; ++ring) {
+            uint32_t a = first + 1 + (ring - 1) * CAP_SEGMENTS, b = a + CAP_SEGMENTS;
+            *index++ = a + s, *index++ = b + s, *index++ = b + next;
+            *index++ = a + s, *index++ = b + next, *index++ = a + next;
+        }
+    }
+    return index;
+}
+
 /* Fills caps (same joint count and pose as body) with the cap geometry described above. */
 static void rigid_caps_mesh(const sp_skin_mesh* body, sp_skin_mesh* caps)
 {
-    const uint32_t cap_vertices = 1 + CAP_RINGS * CAP_SEGMENTS;
-    const uint32_t cap_triangles = CAP_SEGMENTS + 2 * CAP_SEGMENTS * (CAP_RINGS - 1);
     memset(caps, 0, sizeof(*caps));
     snprintf(caps->name, sizeof(caps->name), "%.40s rigid caps", body->name);
-    caps->vertex_count = CAP_COUNT * cap_vertices;
-    caps->triangle_count = CAP_COUNT * cap_triangles;
+    caps->vertex_count = CAP_COUNT * CAP_VERTICES;
+    caps->triangle_count = CAP_COUNT * CAP_TRIANGLES;
     caps->joint_count = body->joint_count;
     caps->influences = 8;
     caps->pose_count = 1;
@@ -300,42 +371,8 @@ static void rigid_caps_mesh(const sp_skin_mesh* body, sp_skin_mesh* caps)
             low[c] = fminf(low[c], body->positions[3 * v + c]);
             high[c] = fmaxf(high[c], body->positions[3 * v + c]);
         }
-    float size = fmaxf(high[0] - low[0], fmaxf(high[1] - low[1], high[2] - low[2])), radius = 0.1f * size;
-    const double half_angle = 50.0 * 3.14159265358979 / 180.0;
     uint32_t* index = caps->indices;
-    for (uint32_t cap = 0; cap < CAP_COUNT; ++cap) {
-        /* axis +-x, +-y, +-z; the cap's sphere sits one box size outside the box on that side */
-        int axis = (int)cap / 2;
-        float sign = cap % 2 ? -1.0f : 1.0f, normal[3] = {0, 0, 0}, center[3];
-        normal[axis] = sign;
-        for (int c = 0; c < 3; ++c) center[c] = 0.5f * (low[c] + high[c]);
-        center[axis] = (sign > 0 ? high[axis] : low[axis]) + sign * size;
-        /* tangents u, w with u x w = normal, so counter-clockwise triangles face outwards */
-        float u[3] = {0, 0, 0}, w[3];
-        u[(axis + 1) % 3] = 1;
-        w[0] = normal[1] * u[2] - normal[2] * u[1];
-        w[1] = normal[2] * u[0] - normal[0] * u[2];
-        w[2] = normal[0] * u[1] - normal[1] * u[0];
-        uint32_t first = cap * cap_vertices;
-        for (uint32_t i = 0; i < cap_vertices; ++i) {
-            uint32_t ring = i == 0 ? 0 : 1 + (i - 1) / CAP_SEGMENTS, segment = i == 0 ? 0 : (i - 1) % CAP_SEGMENTS;
-            double polar = half_angle * ring / CAP_RINGS, azimuth = 6.283185307179586 * segment / CAP_SEGMENTS;
-            for (int c = 0; c < 3; ++c)
-                caps->positions[3 * (first + i) + c] =
-                    center[c] + radius * (float)(cos(polar) * normal[c] + sin(polar) * (cos(azimuth) * u[c] + sin(azimuth) * w[c]));
-            caps->joints[8 * (size_t)(first + i)] = joint;
-            caps->weights[8 * (size_t)(first + i)] = 1.0f;
-        }
-        for (uint32_t s = 0; s < CAP_SEGMENTS; ++s) {
-            uint32_t next = (s + 1) % CAP_SEGMENTS;
-            *index++ = first, *index++ = first + 1 + s, *index++ = first + 1 + next;
-            for (uint32_t ring = 1; ring < CAP_RINGS; ++ring) {
-                uint32_t a = first + 1 + (ring - 1) * CAP_SEGMENTS, b = a + CAP_SEGMENTS;
-                *index++ = a + s, *index++ = b + s, *index++ = b + next;
-                *index++ = a + s, *index++ = b + next, *index++ = a + next;
-            }
-        }
-    }
+    for (uint32_t cap = 0; cap < CAP_COUNT; ++cap) index = add_cap(caps, cap, low, high, joint, index);
 }
 
 /* The C side of every instance: world = LBS(C-decoded weights) + grid offset, clip = VP world. */
@@ -367,33 +404,26 @@ static instance_reference* reference_instances(const sp_skin_mesh* mesh, const u
     return refs;
 }
 
-/* Compresses mesh (OSS, 32-bit words), builds its meshlets, poses MESHSHADER_INSTANCES
- * instances in front of and behind a camera, runs skin_meshlet_test.comp and checks every
- * record. Returns what the C reference decided (specialised pipeline). */
-static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
+/* The default meshlets of the packed skin; fails when skin.mesh could not hold them. */
+static void build_scene_meshlets(const sp_skin_mesh* mesh, const sp_gpu_default_skin* packed, sp_gpu_meshlets* built)
 {
-    size_t n = mesh->vertex_count;
-    sp_gpu_default_skin packed;
-    sp_gpu_default_skin_build(mesh, &packed);
-    const sp_compressed_skin skin = packed.skin;
-    const uint16_t* joints = packed.joints;
-    const float* weights = packed.weights;
-    uint32_t k = skin.influences;
-    size_t lut_entries = skin.lut_size * k;
-
-    sp_gpu_meshlets built;
-    sp_result result = sp_gpu_meshlets_build(mesh->indices, (size_t)mesh->triangle_count * 3, mesh->positions, n, 12,
-                                             joints, weights, k, &built);
+    sp_result result = sp_gpu_meshlets_build(mesh->indices, (size_t)mesh->triangle_count * 3, mesh->positions,
+                                             mesh->vertex_count, 12, packed->joints, packed->weights,
+                                             packed->skin.influences, built);
     if (result != SP_OK) vkx_fail("sp_build_meshlets: %s", sp_result_string(result));
-    const sp_meshlet_stats* stats = &built.stats;
+    const sp_meshlet_stats* stats = &built->stats;
     printf("%s: %zu meshlets, up to %u vertices / %u triangles / %u joints\n", mesh->name, stats->meshlet_count,
            stats->max_vertices, stats->max_triangles, stats->max_joints);
     if (stats->max_vertices > SP_MESH_SHADER_MAX_VERTICES || stats->max_triangles > SP_MESH_SHADER_MAX_TRIANGLES)
         vkx_fail("the default meshlets exceed skin.mesh's %u vertices / %u triangles", SP_MESH_SHADER_MAX_VERTICES,
                  SP_MESH_SHADER_MAX_TRIANGLES);
+}
 
-    /* The scene: instances on a 4 x 2 grid, each turned another way; the camera stands between
-     * the rows looking at the second, so the first row is behind the eye (w < 0: kept). */
+/* The scene: instances on a 4 x 2 grid, each turned another way; the camera stands between
+ * the rows looking at the second, so the first row is behind the eye (w < 0: kept). */
+static SpSkinParameters scene_parameters(const sp_skin_mesh* mesh, const sp_gpu_meshlets* built)
+{
+    size_t n = mesh->vertex_count;
     double extent = 1e-6;
     for (size_t i = 0; i < n * 3; ++i) extent = fmax(extent, fabs((double)mesh->positions[i]));
     double spacing = 1.25 * extent;
@@ -404,64 +434,110 @@ static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
     sp_gpu_camera(16.0f / 9.0f, eye, target, params.view_projection.columns);
     params.counts = (sp_gpu_uvec4){(uint32_t)n, mesh->joint_count, MESHSHADER_COLUMNS, 0};
     params.camera = (sp_gpu_vec4){eye[0], eye[1], eye[2], (float)spacing};
-    params.meshlet_arrays = (sp_gpu_uvec4){built.offsets[0], built.offsets[1], built.offsets[2], built.offsets[3]};
-    params.meshlet_extra = (sp_gpu_uvec4){built.offsets[4], (uint32_t)stats->meshlet_count, 0, 0};
-    float* matrices = instance_matrices(mesh, MESHSHADER_INSTANCES);
-    instance_reference* refs = reference_instances(mesh, joints, weights, k, matrices, &params, MESHSHADER_INSTANCES);
+    params.meshlet_arrays = (sp_gpu_uvec4){built->offsets[0], built->offsets[1], built->offsets[2], built->offsets[3]};
+    params.meshlet_extra = (sp_gpu_uvec4){built->offsets[4], (uint32_t)built->stats.meshlet_count, 0, 0};
+    return params;
+}
 
-    vkx_context* ctx = &h->ctx;
-    SpGpuCodec gpu_codec = sp_gpu_codec_fill(&skin.codec, skin.tuple_bits, skin.words_per_vertex, skin.joint_bytes,
-                                             (uint32_t)skin.lut_size, mesh->joint_count);
-    vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
-    memcpy(codec_buffer.mapped, &gpu_codec, sizeof(gpu_codec));
+/* The input buffers of skin_meshlet_test.comp, all but its output. */
+typedef struct scene_buffers {
+    vkx_buffer codec, words, lut, matrices, positions, meshlets, data;
+} scene_buffers;
+
+static void upload_scene(vkx_context* ctx, const sp_skin_mesh* mesh, const sp_gpu_default_skin* packed,
+                         const sp_gpu_meshlets* built, const SpGpuCodec* gpu_codec, const float* matrices, scene_buffers* b)
+{
+    const sp_compressed_skin* skin = &packed->skin;
+    size_t n = mesh->vertex_count, lut_entries = skin->lut_size * skin->influences;
     VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    vkx_buffer words_buffer = vkx_upload(ctx, packed.words, n * skin.words_per_vertex * 4, storage);
-    vkx_buffer lut_buffer = vkx_upload(ctx, packed.lut_bytes, lut_entries * skin.joint_bytes, storage);
-    vkx_buffer matrix_buffer = vkx_upload(ctx, matrices, (size_t)MESHSHADER_INSTANCES * mesh->joint_count * 12 * sizeof(float), storage);
-    vkx_buffer position_buffer = vkx_upload(ctx, mesh->positions, n * 3 * sizeof(float), storage);
-    vkx_buffer meshlet_buffer = vkx_upload(ctx, built.arrays.meshlets, stats->meshlet_count * sizeof(sp_meshlet), storage);
-    vkx_buffer data_buffer = vkx_upload(ctx, built.data, built.data_words * 4, storage);
-    vkx_buffer* inputs[SP_BINDING_COUNT] = {0};
-    inputs[SP_BINDING_CODEC] = &codec_buffer;
-    inputs[SP_BINDING_VERTEX_WORDS] = &words_buffer;
-    inputs[SP_BINDING_TUPLE_LUT] = &lut_buffer;
-    inputs[SP_BINDING_JOINT_MATRICES] = &matrix_buffer;
-    inputs[SP_BINDING_POSITIONS] = &position_buffer;
-    inputs[SP_BINDING_MESHLETS] = &meshlet_buffer;
-    inputs[SP_BINDING_MESHLET_DATA] = &data_buffer;
+    b->codec = vkx_host_buffer(ctx, gpu_codec, sizeof(*gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    b->words = vkx_upload(ctx, packed->words, n * skin->words_per_vertex * 4, storage);
+    b->lut = vkx_upload(ctx, packed->lut_bytes, lut_entries * skin->joint_bytes, storage);
+    b->matrices = vkx_upload(ctx, matrices, (size_t)MESHSHADER_INSTANCES * mesh->joint_count * 12 * sizeof(float), storage);
+    b->positions = vkx_upload(ctx, mesh->positions, n * 3 * sizeof(float), storage);
+    b->meshlets = vkx_upload(ctx, built->arrays.meshlets, built->stats.meshlet_count * sizeof(sp_meshlet), storage);
+    b->data = vkx_upload(ctx, built->data, built->data_words * 4, storage);
+}
+
+static void destroy_scene(vkx_context* ctx, scene_buffers* b)
+{
+    vkx_buffer* all[] = {&b->codec, &b->words, &b->lut, &b->matrices, &b->positions, &b->meshlets, &b->data};
+    for (size_t i = 0; i < sizeof(all) / sizeof(all[0]); ++i) vkx_buffer_destroy(ctx, all[i]);
+}
+
+/* The meshes, poses and C references one pipeline is checked against. */
+typedef struct scene {
+    const sp_skin_mesh* mesh;
+    sp_gpu_meshlets built;
+    SpSkinParameters params;
+    float* matrices; /* MESHSHADER_INSTANCES x joint_count rows */
+    instance_reference* refs;
+    vkx_buffer* inputs[SP_BINDING_COUNT];
+} scene;
+
+/* Runs the scene through one pipeline, checks every record and prints what C decided. */
+static cull_counts check_scene_pipeline(harness* h, const scene* sc, const vkx_specialization* spec, const char* name)
+{
+    vkx_context* ctx = &h->ctx;
+    size_t meshlet_count = sc->built.stats.meshlet_count;
+    VkPipeline pipeline = vkx_compute_pipeline(ctx, "skin_meshlet_test.comp.spv", spec);
+    SpMeshletOutputRecord* records = gpu_meshlet_outputs(h, pipeline, sc->inputs, &sc->params, (uint32_t)meshlet_count,
+                                                         MESHSHADER_INSTANCES);
+    vkDestroyPipeline(ctx->device, pipeline, NULL);
+    cull_counts counts = {0};
+    size_t failures_before = h->failures;
+    for (uint32_t i = 0; i < MESHSHADER_INSTANCES; ++i)
+        for (size_t m = 0; m < meshlet_count; ++m)
+            check_meshlet_record(h, &sc->built, m, i, &records[i * meshlet_count + m], &sc->refs[i],
+                                 sc->matrices + (size_t)i * sc->mesh->joint_count * 12, &sc->params, &counts);
+    free(records);
+    printf("  %s pipeline: %zu mismatches\n", name, h->failures - failures_before);
+    printf("    triangles: %zu culled, %zu kept facing the camera, %zu kept behind the eye, %zu skipped (|det| or |w| ~ 0)\n",
+           counts.culled, counts.front, counts.behind_eye, counts.skipped);
+    printf("    rigid meshlets with a cone (x instances): %zu - %zu culled, %zu kept, %zu skipped (dot ~ cutoff)\n",
+           counts.rigid, counts.cone_culled, counts.cone_kept, counts.cone_skipped);
+    return counts;
+}
+
+/* Compresses mesh (OSS, 32-bit words), builds its meshlets, poses MESHSHADER_INSTANCES
+ * instances in front of and behind a camera, runs skin_meshlet_test.comp and checks every
+ * record. Returns what the C reference decided (specialised pipeline). */
+static cull_counts meshshader_scene(harness* h, const sp_skin_mesh* mesh)
+{
+    sp_gpu_default_skin packed;
+    sp_gpu_default_skin_build(mesh, &packed);
+    scene sc = {.mesh = mesh};
+    build_scene_meshlets(mesh, &packed, &sc.built);
+    sc.params = scene_parameters(mesh, &sc.built);
+    sc.matrices = instance_matrices(mesh, MESHSHADER_INSTANCES);
+    sc.refs = reference_instances(mesh, packed.joints, packed.weights, packed.skin.influences, sc.matrices, &sc.params,
+                                  MESHSHADER_INSTANCES);
+
+    SpGpuCodec gpu_codec = sp_gpu_skin_codec(&packed.skin, mesh->joint_count);
+    scene_buffers buffers;
+    upload_scene(&h->ctx, mesh, &packed, &sc.built, &gpu_codec, sc.matrices, &buffers);
+    sc.inputs[SP_BINDING_CODEC] = &buffers.codec;
+    sc.inputs[SP_BINDING_VERTEX_WORDS] = &buffers.words;
+    sc.inputs[SP_BINDING_TUPLE_LUT] = &buffers.lut;
+    sc.inputs[SP_BINDING_JOINT_MATRICES] = &buffers.matrices;
+    sc.inputs[SP_BINDING_POSITIONS] = &buffers.positions;
+    sc.inputs[SP_BINDING_MESHLETS] = &buffers.meshlets;
+    sc.inputs[SP_BINDING_MESHLET_DATA] = &buffers.data;
 
     /* Decoder picked at run time, then specialised to the codec (what an engine ships). */
-    vkx_specialization specs[2] = {sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, NULL),
-                                   sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, &gpu_codec)};
-    cull_counts counts = {0};
-    for (int s = 0; s < 2; ++s) {
-        VkPipeline pipeline = vkx_compute_pipeline(ctx, "skin_meshlet_test.comp.spv", &specs[s]);
-        SpMeshletOutputRecord* records = gpu_meshlet_outputs(h, pipeline, inputs, &params, (uint32_t)stats->meshlet_count,
-                                                             MESHSHADER_INSTANCES);
-        vkDestroyPipeline(ctx->device, pipeline, NULL);
-        memset(&counts, 0, sizeof(counts));
-        size_t failures_before = h->failures;
-        for (uint32_t i = 0; i < MESHSHADER_INSTANCES; ++i)
-            for (size_t m = 0; m < stats->meshlet_count; ++m)
-                check_meshlet_record(h, &built, m, i, &records[i * stats->meshlet_count + m], &refs[i],
-                                     matrices + (size_t)i * mesh->joint_count * 12, &params, &counts);
-        free(records);
-        printf("  %s pipeline: %zu mismatches\n", s == 0 ? "runtime-decoder" : "specialised", h->failures - failures_before);
-        printf("    triangles: %zu culled, %zu kept facing the camera, %zu kept behind the eye, %zu skipped (|det| or |w| ~ 0)\n",
-               counts.culled, counts.front, counts.behind_eye, counts.skipped);
-        printf("    rigid meshlets with a cone (x instances): %zu - %zu culled, %zu kept, %zu skipped (dot ~ cutoff)\n",
-               counts.rigid, counts.cone_culled, counts.cone_kept, counts.cone_skipped);
-    }
+    vkx_specialization runtime = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, NULL);
+    vkx_specialization specialised = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, &gpu_codec);
+    check_scene_pipeline(h, &sc, &runtime, "runtime-decoder");
+    cull_counts counts = check_scene_pipeline(h, &sc, &specialised, "specialised");
 
-    vkx_buffer* all[] = {&codec_buffer, &words_buffer, &lut_buffer, &matrix_buffer, &position_buffer, &meshlet_buffer, &data_buffer};
-    for (size_t i = 0; i < sizeof(all) / sizeof(all[0]); ++i) vkx_buffer_destroy(ctx, all[i]);
+    destroy_scene(&h->ctx, &buffers);
     for (uint32_t i = 0; i < MESHSHADER_INSTANCES; ++i) {
-        free(refs[i].world);
-        free(refs[i].clip);
+        free(sc.refs[i].world);
+        free(sc.refs[i].clip);
     }
-    free(refs);
-    free(matrices);
-    sp_gpu_meshlets_free(&built);
+    free(sc.refs);
+    free(sc.matrices);
+    sp_gpu_meshlets_free(&sc.built);
     sp_gpu_default_skin_free(&packed);
     return counts;
 }

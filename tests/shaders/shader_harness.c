@@ -58,12 +58,10 @@ SpDecodedRecord* gpu_decode(harness* h, const SpGpuCodec* codec, uint32_t mode, 
                                    size_t word_count, size_t item_count, const void* lut, size_t lut_bytes, int force_wide)
 {
     vkx_context* ctx = &h->ctx;
-    vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(*codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
-    memcpy(codec_buffer.mapped, codec, sizeof(*codec));
+    vkx_buffer codec_buffer = vkx_host_buffer(ctx, codec, sizeof(*codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     vkx_buffer input = vkx_upload(ctx, words, word_count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer lut_buffer = vkx_upload(ctx, lut, lut ? lut_bytes : 0, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    vkx_buffer output = vkx_buffer_create(ctx, item_count * sizeof(SpDecodedRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
-    memset(output.mapped, 0xcd, output.size); /* garbage: an item the shader skips cannot pass */
+    vkx_buffer output = vkx_poisoned_buffer(ctx, item_count * sizeof(SpDecodedRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     vkx_buffer* bindings[SP_BINDING_COUNT] = {0};
     bindings[SP_BINDING_CODEC] = &codec_buffer;
@@ -353,64 +351,77 @@ static size_t check_in_layer_rows(harness* h)
     return 2;
 }
 
+enum { RANDOM_CODES = 256, MAX_SAMPLED_CODES = 1024 };
+
+/* OSS layer and row boundaries, where the float estimates are off by one. */
+static void add_oss_boundary_codes(const sp_codec* codec, uint32_t k, uint64_t* codes, size_t* count)
+{
+    uint64_t layers = k == 4 ? (codec->n + 1) / 2 : 1;
+    for (int i = 0; i < 48; ++i) {
+        uint64_t layer = k == 4 ? (i < 4 ? (uint64_t)i % layers : random_next() % layers) : 0;
+        if (i == 5) layer = layers - 1;
+        uint64_t bottom = codec->n - 2 * layer;
+        uint64_t rows = (2 * bottom + 1) / 3;
+        uint64_t row = i < 8 ? (uint64_t)i % rows : random_next() % rows;
+        if (i == 9) row = rows - 1;
+        u128 base = (k == 4 ? (u128)sp_oss_layer_base(codec->n, layer) : 0) + sp_oss_row_base(bottom, row);
+        add_code(codec, codes, count, base);
+        if (base > 0) add_code(codec, codes, count, base - 1);
+        add_code(codec, codes, count, base + 1);
+    }
+}
+
+/* The first, last and middle code, the codes of random weights and, for OSS, boundaries.
+ * Returns 0 when the method has no codec of exactly this width. */
+static int check_sampled_width(harness* h, sp_method method, uint32_t k, uint32_t bits)
+{
+    uint64_t codes[MAX_SAMPLED_CODES];
+    sp_codec codec;
+    if (sp_codec_from_bits(method, k, bits, &codec) != SP_OK)
+        return 0; /* no configuration of this width (e.g. POT below its minimum) */
+    if (codec.bits != bits) return 0; /* the same codec as a narrower width */
+    size_t count = 0;
+    add_code(&codec, codes, &count, 0);
+    add_code(&codec, codes, &count, codec.max_code);
+    add_code(&codec, codes, &count, codec.max_code / 2);
+    for (int i = 0; i < RANDOM_CODES; ++i) {
+        float w[4];
+        random_weights(k, w);
+        add_code(&codec, codes, &count, sp_encode_weights(&codec, w));
+    }
+    if (method == SP_METHOD_OSS && k >= 3) add_oss_boundary_codes(&codec, k, codes, &count);
+    decode_and_check(h, &codec, codes, count, "sampled");
+    return 1;
+}
+
+/* The 32-bit decoder at its limit: the largest OSS N whose codes it still takes (K = 3, 4),
+ * top codes included, where the closed forms come closest to 2^32; N + 1 must not take it. */
+static void check_narrow_limit(harness* h, uint32_t k)
+{
+    uint64_t codes[MAX_SAMPLED_CODES];
+    uint64_t limit = k == 4 ? SP_OSS_NARROW_MAX_CODE_K4 : SP_OSS_NARROW_MAX_CODE_K3, n = 2;
+    while ((k == 4 ? sp_oss_tetrahedron_count(n + 1) : sp_oss_triangle_count(n + 1)) - 1 <= limit) ++n;
+    sp_codec codec;
+    configure(h, SP_METHOD_OSS, k, n, NULL, &codec);
+    SpGpuCodec gpu = sp_gpu_codec_fill(&codec, 0, 2, 1, 1, 1);
+    if (!SP_GPU_CODEC_IS_NARROW(gpu)) fail_check(h, "OSS K=%u N=%llu should take the 32-bit decoder", k, (unsigned long long)n);
+    size_t count = 0;
+    for (uint64_t back = 0; back < 64; ++back) add_code(&codec, codes, &count, codec.max_code - back);
+    for (int i = 0; i < RANDOM_CODES; ++i) add_code(&codec, codes, &count, random_next() % (codec.max_code + 1));
+    decode_and_check(h, &codec, codes, count, "narrow limit");
+    configure(h, SP_METHOD_OSS, k, n + 1, NULL, &codec);
+    gpu = sp_gpu_codec_fill(&codec, 0, 2, 1, 1, 1);
+    if (SP_GPU_CODEC_IS_NARROW(gpu)) fail_check(h, "OSS K=%u N=%llu should take the 64-bit decoder", k, (unsigned long long)n + 1);
+}
+
 static void test_widths(harness* h)
 {
-    enum { RANDOM_CODES = 256, MAX_CODES = 1024 };
-    uint64_t codes[MAX_CODES];
     size_t configurations = 0;
-    for (int method = 0; method < SP_METHOD_COUNT; ++method) {
-        for (uint32_t k = 2; k <= 4; ++k) {
-            for (uint32_t bits = 1; bits <= 64; ++bits) {
-                sp_codec codec;
-                if (sp_codec_from_bits((sp_method)method, k, bits, &codec) != SP_OK)
-                    continue; /* no configuration of this width (e.g. POT below its minimum) */
-                if (codec.bits != bits) continue; /* the same codec as a narrower width */
-                size_t count = 0;
-                add_code(&codec, codes, &count, 0);
-                add_code(&codec, codes, &count, codec.max_code);
-                add_code(&codec, codes, &count, codec.max_code / 2);
-                for (int i = 0; i < RANDOM_CODES; ++i) {
-                    float w[4];
-                    random_weights(k, w);
-                    add_code(&codec, codes, &count, sp_encode_weights(&codec, w));
-                }
-                if (method == SP_METHOD_OSS && k >= 3) {
-                    /* Layer and row boundaries, where the float estimates are off by one. */
-                    uint64_t layers = k == 4 ? (codec.n + 1) / 2 : 1;
-                    for (int i = 0; i < 48; ++i) {
-                        uint64_t layer = k == 4 ? (i < 4 ? (uint64_t)i % layers : random_next() % layers) : 0;
-                        if (i == 5) layer = layers - 1;
-                        uint64_t bottom = codec.n - 2 * layer;
-                        uint64_t rows = (2 * bottom + 1) / 3;
-                        uint64_t row = i < 8 ? (uint64_t)i % rows : random_next() % rows;
-                        if (i == 9) row = rows - 1;
-                        u128 base = (k == 4 ? (u128)sp_oss_layer_base(codec.n, layer) : 0) + sp_oss_row_base(bottom, row);
-                        add_code(&codec, codes, &count, base);
-                        if (base > 0) add_code(&codec, codes, &count, base - 1);
-                        add_code(&codec, codes, &count, base + 1);
-                    }
-                }
-                decode_and_check(h, &codec, codes, count, "sampled");
-                ++configurations;
-            }
-        }
-    }
-    /* The 32-bit decoder at its limit: the largest OSS N whose codes it still takes (K = 3, 4),
-     * top codes included, where the closed forms come closest to 2^32. */
+    for (int method = 0; method < SP_METHOD_COUNT; ++method)
+        for (uint32_t k = 2; k <= 4; ++k)
+            for (uint32_t bits = 1; bits <= 64; ++bits) configurations += (size_t)check_sampled_width(h, (sp_method)method, k, bits);
     for (uint32_t k = 3; k <= 4; ++k) {
-        uint64_t limit = k == 4 ? SP_OSS_NARROW_MAX_CODE_K4 : SP_OSS_NARROW_MAX_CODE_K3, n = 2;
-        while ((k == 4 ? sp_oss_tetrahedron_count(n + 1) : sp_oss_triangle_count(n + 1)) - 1 <= limit) ++n;
-        sp_codec codec;
-        configure(h, SP_METHOD_OSS, k, n, NULL, &codec);
-        SpGpuCodec gpu = sp_gpu_codec_fill(&codec, 0, 2, 1, 1, 1);
-        if (!SP_GPU_CODEC_IS_NARROW(gpu)) fail_check(h, "OSS K=%u N=%llu should take the 32-bit decoder", k, (unsigned long long)n);
-        size_t count = 0;
-        for (uint64_t back = 0; back < 64; ++back) add_code(&codec, codes, &count, codec.max_code - back);
-        for (int i = 0; i < RANDOM_CODES; ++i) add_code(&codec, codes, &count, random_next() % (codec.max_code + 1));
-        decode_and_check(h, &codec, codes, count, "narrow limit");
-        configure(h, SP_METHOD_OSS, k, n + 1, NULL, &codec);
-        gpu = sp_gpu_codec_fill(&codec, 0, 2, 1, 1, 1);
-        if (SP_GPU_CODEC_IS_NARROW(gpu)) fail_check(h, "OSS K=%u N=%llu should take the 64-bit decoder", k, (unsigned long long)n + 1);
+        check_narrow_limit(h, k);
         configurations += 2;
     }
     configurations += check_in_layer_rows(h);
@@ -419,116 +430,247 @@ static void test_widths(harness* h)
 
 /* ---- test: packed vertex words and tuple LUTs ------------------------------------------------- */
 
-static void test_vertices(harness* h)
-{
-    enum { VERTICES = 4000, STRIDE = 6 };
-    static const uint32_t joint_counts[] = {40, 300}; /* u8 and u16 LUT entries */
-    static const uint32_t vertex_bits[] = {32, 48, 64};
-    uint16_t* joints = malloc(VERTICES * STRIDE * sizeof(uint16_t));
-    float* weights = malloc(VERTICES * STRIDE * sizeof(float));
-    uint32_t* words = malloc(VERTICES * 2 * sizeof(uint32_t));
-    uint16_t* lut = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
-    uint8_t* lut_bytes = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
-    uint16_t* c_joints = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
-    float* c_weights = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(float));
-    uint32_t* tuples = malloc(VERTICES * sizeof(uint32_t));
-    uint64_t* codes = malloc(VERTICES * sizeof(uint64_t));
-    size_t scratch_size = sp_compress_scratch_bound(VERTICES, STRIDE);
-    void* scratch = malloc(scratch_size);
+enum { VERTICES = 4000, STRIDE = 6 };
 
-    for (size_t jc = 0; jc < 2; ++jc) {
-        /* Skin-like data: joints clustered along the vertex index, 1..6 influences. */
-        for (size_t v = 0; v < VERTICES; ++v) {
-            uint32_t used = 1 + (uint32_t)(random_next() % STRIDE);
-            for (uint32_t s = 0; s < STRIDE; ++s) {
-                uint32_t joint = (uint32_t)((v * joint_counts[jc]) / VERTICES + random_next() % 7) % joint_counts[jc];
-                joints[v * STRIDE + s] = (uint16_t)joint;
-                weights[v * STRIDE + s] = s < used ? (float)random_unit() + 0.01f : 0.0f;
-            }
-        }
-        for (int method = 0; method < SP_METHOD_COUNT; ++method) {
-            for (uint32_t k = 1; k <= 4; ++k) {
-                for (size_t b = 0; b < 3; ++b) {
-                    sp_compress_options options;
-                    sp_compress_options_default(&options);
-                    options.method = (sp_method)method;
-                    options.max_influences = k;
-                    options.vertex_bits = vertex_bits[b];
-                    sp_compressed_skin skin;
-                    sp_result result = sp_compress_skin(joints, weights, VERTICES, STRIDE, joint_counts[jc], &options, words,
-                                                        lut, NULL, NULL, &skin, scratch, scratch_size);
-                    if (result != SP_OK) continue; /* e.g. a tuple index that leaves too few weight bits */
-                    uint32_t kk = skin.influences;
-                    result = sp_decompress_skin(&skin.codec, words, VERTICES, skin.tuple_bits, lut, skin.lut_size,
-                                                joint_counts[jc], c_joints, c_weights, NULL);
-                    if (result != SP_OK) {
-                        fail_check(h, "sp_decompress_skin: %s", sp_result_string(result));
-                        continue;
-                    }
-                    sp_unpack_vertices(words, VERTICES, skin.tuple_bits, skin.weight_bits, tuples, codes, NULL);
-                    /* The LUT as stored: bytes when joint_bytes = 1, little-endian u16 otherwise. */
-                    size_t lut_entries = skin.lut_size * kk;
-                    for (size_t e = 0; e < lut_entries; ++e) {
-                        if (skin.joint_bytes == 1) {
-                            lut_bytes[e] = (uint8_t)lut[e];
-                        } else {
-                            lut_bytes[2 * e] = (uint8_t)lut[e];
-                            lut_bytes[2 * e + 1] = (uint8_t)(lut[e] >> 8);
-                        }
-                    }
-                    SpGpuCodec gpu = sp_gpu_codec_fill(&skin.codec, skin.tuple_bits, skin.words_per_vertex,
-                                                       skin.joint_bytes, (uint32_t)skin.lut_size, joint_counts[jc]);
-                    /* One corrupted copy of the last vertex: a set padding bit must be reported. */
-                    uint32_t used_bits = skin.tuple_bits + skin.weight_bits;
-                    size_t wpv = skin.words_per_vertex, items = VERTICES + (used_bits < 32 * wpv ? 1 : 0);
-                    uint32_t* input = malloc((VERTICES + 1) * wpv * sizeof(uint32_t));
-                    memcpy(input, words, VERTICES * wpv * sizeof(uint32_t));
-                    if (items > VERTICES) {
-                        memcpy(input + VERTICES * wpv, words + (VERTICES - 1) * wpv, wpv * sizeof(uint32_t));
-                        input[VERTICES * wpv + used_bits / 32] |= 1u << (used_bits % 32);
-                    }
-                    SpDecodedRecord* records = gpu_decode(h, &gpu, SP_DECODE_MODE_VERTICES, input, items * wpv, items,
-                                                          lut_bytes, lut_entries * skin.joint_bytes, 0);
-                    char label[160];
-                    snprintf(label, sizeof(label), "vertices %s K=%u %u-bit words, %u joints", sp_method_name((sp_method)method),
-                             kk, vertex_bits[b], joint_counts[jc]);
-                    for (size_t v = 0; v < VERTICES; ++v) {
-                        const SpDecodedRecord* r = &records[v];
-                        check_record(h, &skin.codec, codes[v], r, label);
-                        const uint32_t* got_joints = &r->joints.x;
-                        if (r->vertex.x != tuples[v] || r->vertex.y != 1)
-                            fail_check(h, "%s: vertex %zu: tuple %u (C %u), padding flag %u", label, v, r->vertex.x,
-                                       tuples[v], r->vertex.y);
-                        for (uint32_t s = 0; s < kk; ++s)
-                            if (got_joints[s] != c_joints[v * kk + s])
-                                fail_check(h, "%s: vertex %zu slot %u: joint %u on the GPU, %u in C", label, v, s,
-                                           got_joints[s], c_joints[v * kk + s]);
-                        for (uint32_t s = 0; s < kk; ++s)
-                            if (!(fabsf(record_weights(r)[s] - c_weights[v * kk + s]) <= WEIGHT_TOLERANCE))
-                                fail_check(h, "%s: vertex %zu slot %u: weight %.9g on the GPU, %.9g in C", label, v, s,
-                                           (double)record_weights(r)[s], (double)c_weights[v * kk + s]);
-                    }
-                    if (items > VERTICES && records[VERTICES].vertex.y != 0)
-                        fail_check(h, "%s: a set padding bit above bit %u was not reported", label, used_bits);
-                    free(records);
-                    free(input);
-                }
-            }
+/* One random skin, what libskinpack makes of it and the C decoder's view of that. */
+typedef struct vertex_test {
+    uint32_t joint_count;
+    uint16_t* joints; /* STRIDE per vertex */
+    float* weights;
+    uint32_t* words;
+    uint16_t* lut;
+    uint8_t* lut_bytes;
+    uint16_t* c_joints; /* decoded: K per vertex */
+    float* c_weights;
+    uint32_t* tuples;
+    uint64_t* codes;
+    size_t scratch_size;
+    void* scratch;
+} vertex_test;
+
+static void vertex_test_alloc(vertex_test* t)
+{
+    t->joints = malloc(VERTICES * STRIDE * sizeof(uint16_t));
+    t->weights = malloc(VERTICES * STRIDE * sizeof(float));
+    t->words = malloc(VERTICES * 2 * sizeof(uint32_t));
+    t->lut = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
+    t->lut_bytes = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
+    t->c_joints = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(uint16_t));
+    t->c_weights = malloc(VERTICES * SP_MAX_INFLUENCES * sizeof(float));
+    t->tuples = malloc(VERTICES * sizeof(uint32_t));
+    t->codes = malloc(VERTICES * sizeof(uint64_t));
+    t->scratch_size = sp_compress_scratch_bound(VERTICES, STRIDE);
+    t->scratch = malloc(t->scratch_size);
+}
+
+static void vertex_test_free(vertex_test* t)
+{
+    free(t->joints);
+    free(t->weights);
+    free(t->words);
+    free(t->lut);
+    free(t->lut_bytes);
+    free(t->c_joints);
+    free(t->c_weights);
+    free(t->tuples);
+    free(t->codes);
+    free(t->scratch);
+}
+
+/* Skin-like data: joints clustered along the vertex index, 1..6 influences. */
+static void random_skin(vertex_test* t)
+{
+    for (size_t v = 0; v < VERTICES; ++v) {
+        uint32_t used = 1 + (uint32_t)(random_next() % STRIDE);
+        for (uint32_t s = 0; s < STRIDE; ++s) {
+            uint32_t joint = (uint32_t)((v * t->joint_count) / VERTICES + random_next() % 7) % t->joint_count;
+            t->joints[v * STRIDE + s] = (uint16_t)joint;
+            t->weights[v * STRIDE + s] = s < used ? (float)random_unit() + 0.01f : 0.0f;
         }
     }
-    free(joints);
-    free(weights);
-    free(words);
-    free(lut);
-    free(lut_bytes);
-    free(c_joints);
-    free(c_weights);
-    free(tuples);
-    free(codes);
-    free(scratch);
+}
+
+/* The vertex words as decode.comp gets them, plus, when the words have padding, one corrupted
+ * copy of the last vertex: its set padding bit must be reported. *items: vertices in it. */
+static uint32_t* vertex_input(const vertex_test* t, const sp_compressed_skin* skin, size_t* items)
+{
+    uint32_t used_bits = skin->tuple_bits + skin->weight_bits;
+    size_t wpv = skin->words_per_vertex;
+    *items = VERTICES + (used_bits < 32 * wpv ? 1 : 0);
+    uint32_t* input = malloc((VERTICES + 1) * wpv * sizeof(uint32_t));
+    memcpy(input, t->words, VERTICES * wpv * sizeof(uint32_t));
+    if (*items > VERTICES) {
+        memcpy(input + VERTICES * wpv, t->words + (VERTICES - 1) * wpv, wpv * sizeof(uint32_t));
+        input[VERTICES * wpv + used_bits / 32] |= 1u << (used_bits % 32);
+    }
+    return input;
+}
+
+/* Each record's code, tuple index, padding flag, joints and weights against C. */
+static void check_vertex_records(harness* h, const vertex_test* t, const sp_compressed_skin* skin,
+                                 const SpDecodedRecord* records, const char* label)
+{
+    uint32_t kk = skin->influences;
+    for (size_t v = 0; v < VERTICES; ++v) {
+        const SpDecodedRecord* r = &records[v];
+        check_record(h, &skin->codec, t->codes[v], r, label);
+        const uint32_t* got_joints = &r->joints.x;
+        if (r->vertex.x != t->tuples[v] || r->vertex.y != 1)
+            fail_check(h, "%s: vertex %zu: tuple %u (C %u), padding flag %u", label, v, r->vertex.x, t->tuples[v], r->vertex.y);
+        for (uint32_t s = 0; s < kk; ++s)
+            if (got_joints[s] != t->c_joints[v * kk + s])
+                fail_check(h, "%s: vertex %zu slot %u: joint %u on the GPU, %u in C", label, v, s, got_joints[s],
+                           t->c_joints[v * kk + s]);
+        for (uint32_t s = 0; s < kk; ++s)
+            if (!(fabsf(record_weights(r)[s] - t->c_weights[v * kk + s]) <= WEIGHT_TOLERANCE))
+                fail_check(h, "%s: vertex %zu slot %u: weight %.9g on the GPU, %.9g in C", label, v, s,
+                           (double)record_weights(r)[s], (double)t->c_weights[v * kk + s]);
+    }
+}
+
+/* Compresses the skin with one method, K and word size, decodes it on the GPU and checks it. */
+static void check_vertex_config(harness* h, vertex_test* t, sp_method method, uint32_t k, uint32_t vertex_bits)
+{
+    sp_compress_options options;
+    sp_compress_options_default(&options);
+    options.method = method;
+    options.max_influences = k;
+    options.vertex_bits = vertex_bits;
+    sp_compressed_skin skin;
+    sp_result result = sp_compress_skin(t->joints, t->weights, VERTICES, STRIDE, t->joint_count, &options, t->words, t->lut,
+                                        NULL, NULL, &skin, t->scratch, t->scratch_size);
+    if (result != SP_OK) return; /* e.g. a tuple index that leaves too few weight bits */
+    result = sp_decompress_skin(&skin.codec, t->words, VERTICES, skin.tuple_bits, t->lut, skin.lut_size, t->joint_count,
+                                t->c_joints, t->c_weights, NULL);
+    if (result != SP_OK) {
+        fail_check(h, "sp_decompress_skin: %s", sp_result_string(result));
+        return;
+    }
+    sp_unpack_vertices(t->words, VERTICES, skin.tuple_bits, skin.weight_bits, t->tuples, t->codes, NULL);
+    size_t lut_entries = skin.lut_size * skin.influences;
+    sp_gpu_lut_bytes(t->lut, lut_entries, skin.joint_bytes, t->lut_bytes);
+    SpGpuCodec gpu = sp_gpu_skin_codec(&skin, t->joint_count);
+    size_t items;
+    uint32_t* input = vertex_input(t, &skin, &items);
+    SpDecodedRecord* records = gpu_decode(h, &gpu, SP_DECODE_MODE_VERTICES, input, items * skin.words_per_vertex, items,
+                                          t->lut_bytes, lut_entries * skin.joint_bytes, 0);
+    char label[160];
+    snprintf(label, sizeof(label), "vertices %s K=%u %u-bit words, %u joints", sp_method_name(method), skin.influences,
+             vertex_bits, t->joint_count);
+    check_vertex_records(h, t, &skin, records, label);
+    if (items > VERTICES && records[VERTICES].vertex.y != 0)
+        fail_check(h, "%s: a set padding bit above bit %u was not reported", label, skin.tuple_bits + skin.weight_bits);
+    free(records);
+    free(input);
+}
+
+static void test_vertices(harness* h)
+{
+    static const uint32_t joint_counts[] = {40, 300}; /* u8 and u16 LUT entries */
+    static const uint32_t vertex_bits[] = {32, 48, 64};
+    vertex_test t;
+    vertex_test_alloc(&t);
+    for (size_t jc = 0; jc < 2; ++jc) {
+        t.joint_count = joint_counts[jc];
+        random_skin(&t);
+        for (int method = 0; method < SP_METHOD_COUNT; ++method)
+            for (uint32_t k = 1; k <= 4; ++k)
+                for (size_t b = 0; b < 3; ++b) check_vertex_config(h, &t, (sp_method)method, k, vertex_bits[b]);
+    }
+    vertex_test_free(&t);
 }
 
 /* ---- test: meshlet palette and local tuple LUT fetch ------------------------------------------ */
+
+/* What skin.mesh reads, checked on lavapipe (which has no mesh shaders) through decode.comp's
+ * meshlet mode: per meshlet vertex, joints via palette + local LUT must equal the global tuple
+ * LUT's joints (slots with non-zero weight), weights the C decoder's; triangle corners must be
+ * the meshlet's triangles as sp_build_meshlets wrote them. */
+/* What decode.comp's meshlet mode wrote: a record per meshlet vertex, three source-vertex
+ * corners per meshlet triangle. */
+typedef struct meshlet_fetch {
+    vkx_buffer records, corners;
+} meshlet_fetch;
+
+/* One decode.comp dispatch in meshlet mode, a workgroup per meshlet. The caller destroys the
+ * fetch's buffers. */
+static meshlet_fetch gpu_meshlet_fetch(harness* h, const sp_gpu_default_skin* packed, const sp_gpu_meshlets* built,
+                                       uint32_t joint_count, size_t vertex_count)
+{
+    const sp_compressed_skin* skin = &packed->skin;
+    const sp_meshlet_stats* stats = &built->stats;
+    /* The five arrays in one word buffer, as skinpack_gpu_layout.h describes. */
+    decode_push push = {SP_DECODE_MODE_MESHLETS, (uint32_t)stats->meshlet_count, 0, {0}};
+    for (int a = 0; a < 5; ++a) push.meshlet_arrays[a] = built->offsets[a];
+
+    vkx_context* ctx = &h->ctx;
+    VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    SpGpuCodec gpu_codec = sp_gpu_skin_codec(skin, joint_count);
+    vkx_buffer codec_buffer = vkx_host_buffer(ctx, &gpu_codec, sizeof(gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    vkx_buffer words_buffer = vkx_upload(ctx, packed->words, vertex_count * skin->words_per_vertex * 4, storage);
+    vkx_buffer meshlet_buffer = vkx_upload(ctx, built->arrays.meshlets, stats->meshlet_count * sizeof(sp_meshlet), storage);
+    vkx_buffer data_buffer = vkx_upload(ctx, built->data, built->data_words * 4, storage);
+    meshlet_fetch fetch;
+    fetch.records = vkx_poisoned_buffer(ctx, stats->vertex_count * sizeof(SpDecodedRecord), storage);
+    fetch.corners = vkx_poisoned_buffer(ctx, stats->triangle_count * 12, storage);
+    vkx_buffer* bindings[SP_BINDING_COUNT] = {0};
+    bindings[SP_BINDING_CODEC] = &codec_buffer;
+    bindings[SP_BINDING_VERTEX_WORDS] = &words_buffer;
+    bindings[SP_BINDING_MESHLETS] = &meshlet_buffer;
+    bindings[SP_BINDING_MESHLET_DATA] = &data_buffer;
+    bindings[SP_BINDING_OUTPUT] = &fetch.records;
+    bindings[SP_BINDING_POSITIONS] = &fetch.corners;
+    VkDescriptorSet set = vkx_descriptor_set(ctx, bindings, &h->dummy);
+    vkx_dispatch_and_wait(ctx, h->decode_pipeline, set, &push, (uint32_t)sizeof(push), (uint32_t)stats->meshlet_count, 1);
+    vkResetDescriptorPool(ctx->device, ctx->descriptor_pool, 0);
+    vkx_buffer* inputs[] = {&codec_buffer, &words_buffer, &meshlet_buffer, &data_buffer};
+    for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]); ++i) vkx_buffer_destroy(ctx, inputs[i]);
+    return fetch;
+}
+
+/* Meshlet m's vertices: source vertex, palette and LUT sizes, joints and weights. */
+static void check_meshlet_vertices(harness* h, const sp_gpu_default_skin* packed, const sp_gpu_meshlets* built, size_t m,
+                                   const SpDecodedRecord* records)
+{
+    const sp_meshlet* meshlet = &built->arrays.meshlets[m];
+    const uint16_t* joints = packed->joints;
+    const float* weights = packed->weights;
+    uint32_t k = packed->skin.influences;
+    for (uint32_t i = 0; i < meshlet->vertex_count; ++i) {
+        const SpDecodedRecord* r = &records[meshlet->vertex_offset + i];
+        uint32_t v = built->arrays.vertices[meshlet->vertex_offset + i];
+        ++h->checked;
+        if (r->vertex.x != v || r->vertex.z != meshlet->joint_count || r->vertex.w != meshlet->tuple_count) {
+            fail_check(h, "meshlet %zu vertex %u: source vertex %u (want %u), palette %u (%u), LUT %u (%u)", m, i,
+                       r->vertex.x, v, r->vertex.z, meshlet->joint_count, r->vertex.w, meshlet->tuple_count);
+            continue;
+        }
+        const uint32_t* got = &r->joints.x;
+        for (uint32_t slot = 0; slot < k; ++slot) {
+            if (weights[v * k + slot] > 0 && got[slot] != joints[v * k + slot])
+                fail_check(h, "meshlet %zu vertex %u slot %u: joint %u via palette, %u via the tuple LUT", m, i, slot,
+                           got[slot], joints[v * k + slot]);
+            if (!(fabsf(record_weights(r)[slot] - weights[v * k + slot]) <= WEIGHT_TOLERANCE))
+                fail_check(h, "meshlet %zu vertex %u slot %u: weight %.9g, C %.9g", m, i, slot,
+                           (double)record_weights(r)[slot], (double)weights[v * k + slot]);
+        }
+    }
+}
+
+/* Meshlet m's triangle corners, as source vertices. */
+static void check_meshlet_corners(harness* h, const sp_gpu_meshlets* built, size_t m, const uint32_t* corners)
+{
+    const sp_meshlet_buffers* out = &built->arrays;
+    const sp_meshlet* meshlet = &out->meshlets[m];
+    for (uint32_t t = 0; t < meshlet->triangle_count; ++t)
+        for (int c = 0; c < 3; ++c) {
+            uint32_t local = out->triangles[3 * (meshlet->triangle_offset + t) + c];
+            uint32_t want = out->vertices[meshlet->vertex_offset + local];
+            if (corners[3 * (meshlet->triangle_offset + t) + c] != want)
+                fail_check(h, "meshlet %zu triangle %u corner %d: vertex %u, want %u", m, t, c,
+                           corners[3 * (meshlet->triangle_offset + t) + c], want);
+        }
+}
 
 /* What skin.mesh reads, checked on lavapipe (which has no mesh shaders) through decode.comp's
  * meshlet mode: per meshlet vertex, joints via palette + local LUT must equal the global tuple
@@ -538,86 +680,23 @@ static void test_meshlets(harness* h, const char* path)
 {
     sp_skin_mesh mesh;
     sp_skin_mesh_load(path, &mesh);
-    size_t n = mesh.vertex_count;
     sp_gpu_default_skin packed;
     sp_gpu_default_skin_build(&mesh, &packed);
-    const sp_compressed_skin skin = packed.skin;
-    const uint16_t* joints = packed.joints;
-    const float* weights = packed.weights;
-    uint32_t k = skin.influences;
-
     sp_gpu_meshlets built;
-    sp_result result = sp_gpu_meshlets_build(mesh.indices, (size_t)mesh.triangle_count * 3, mesh.positions, n, 12,
-                                             joints, weights, k, &built);
+    sp_result result = sp_gpu_meshlets_build(mesh.indices, (size_t)mesh.triangle_count * 3, mesh.positions, mesh.vertex_count,
+                                             12, packed.joints, packed.weights, packed.skin.influences, &built);
     if (result != SP_OK) vkx_fail("sp_build_meshlets: %s", sp_result_string(result));
-    const sp_meshlet_buffers out = built.arrays;
-    const sp_meshlet_stats stats = built.stats;
+    const sp_meshlet_stats* stats = &built.stats;
     printf("meshlets of %s: %zu meshlets, %zu vertex entries, %zu triangles, palettes up to %u joints\n", mesh.name,
-           stats.meshlet_count, stats.vertex_count, stats.triangle_count, stats.max_joints);
+           stats->meshlet_count, stats->vertex_count, stats->triangle_count, stats->max_joints);
 
-    /* The five arrays in one word buffer, as skinpack_gpu_layout.h describes. */
-    decode_push push = {SP_DECODE_MODE_MESHLETS, (uint32_t)stats.meshlet_count, 0, {0}};
-    for (int a = 0; a < 5; ++a) push.meshlet_arrays[a] = built.offsets[a];
-    const uint32_t* data = built.data;
-    size_t total_words = built.data_words;
-
-    vkx_context* ctx = &h->ctx;
-    SpGpuCodec gpu_codec = sp_gpu_codec_fill(&skin.codec, skin.tuple_bits, skin.words_per_vertex, skin.joint_bytes,
-                                             (uint32_t)skin.lut_size, mesh.joint_count);
-    vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(gpu_codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
-    memcpy(codec_buffer.mapped, &gpu_codec, sizeof(gpu_codec));
-    vkx_buffer words_buffer = vkx_upload(ctx, packed.words, n * skin.words_per_vertex * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    vkx_buffer meshlet_buffer = vkx_upload(ctx, out.meshlets, stats.meshlet_count * sizeof(sp_meshlet), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    vkx_buffer data_buffer = vkx_upload(ctx, data, total_words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    vkx_buffer records_buffer = vkx_buffer_create(ctx, stats.vertex_count * sizeof(SpDecodedRecord), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
-    vkx_buffer corners_buffer = vkx_buffer_create(ctx, stats.triangle_count * 12, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
-    memset(records_buffer.mapped, 0xcd, records_buffer.size);
-    memset(corners_buffer.mapped, 0xcd, corners_buffer.size);
-    vkx_buffer* bindings[SP_BINDING_COUNT] = {0};
-    bindings[SP_BINDING_CODEC] = &codec_buffer;
-    bindings[SP_BINDING_VERTEX_WORDS] = &words_buffer;
-    bindings[SP_BINDING_MESHLETS] = &meshlet_buffer;
-    bindings[SP_BINDING_MESHLET_DATA] = &data_buffer;
-    bindings[SP_BINDING_OUTPUT] = &records_buffer;
-    bindings[SP_BINDING_POSITIONS] = &corners_buffer;
-    VkDescriptorSet set = vkx_descriptor_set(ctx, bindings, &h->dummy);
-    vkx_dispatch_and_wait(ctx, h->decode_pipeline, set, &push, (uint32_t)sizeof(push), (uint32_t)stats.meshlet_count, 1);
-
-    const SpDecodedRecord* records = records_buffer.mapped;
-    const uint32_t* corners = corners_buffer.mapped;
-    for (size_t m = 0; m < stats.meshlet_count; ++m) {
-        const sp_meshlet* meshlet = &out.meshlets[m];
-        for (uint32_t i = 0; i < meshlet->vertex_count; ++i) {
-            const SpDecodedRecord* r = &records[meshlet->vertex_offset + i];
-            uint32_t v = out.vertices[meshlet->vertex_offset + i];
-            ++h->checked;
-            if (r->vertex.x != v || r->vertex.z != meshlet->joint_count || r->vertex.w != meshlet->tuple_count) {
-                fail_check(h, "meshlet %zu vertex %u: source vertex %u (want %u), palette %u (%u), LUT %u (%u)", m, i,
-                           r->vertex.x, v, r->vertex.z, meshlet->joint_count, r->vertex.w, meshlet->tuple_count);
-                continue;
-            }
-            const uint32_t* got = &r->joints.x;
-            for (uint32_t slot = 0; slot < k; ++slot) {
-                if (weights[v * k + slot] > 0 && got[slot] != joints[v * k + slot])
-                    fail_check(h, "meshlet %zu vertex %u slot %u: joint %u via palette, %u via the tuple LUT", m, i, slot,
-                               got[slot], joints[v * k + slot]);
-                if (!(fabsf(record_weights(r)[slot] - weights[v * k + slot]) <= WEIGHT_TOLERANCE))
-                    fail_check(h, "meshlet %zu vertex %u slot %u: weight %.9g, C %.9g", m, i, slot,
-                               (double)record_weights(r)[slot], (double)weights[v * k + slot]);
-            }
-        }
-        for (uint32_t t = 0; t < meshlet->triangle_count; ++t)
-            for (int c = 0; c < 3; ++c) {
-                uint32_t local = out.triangles[3 * (meshlet->triangle_offset + t) + c];
-                uint32_t want = out.vertices[meshlet->vertex_offset + local];
-                if (corners[3 * (meshlet->triangle_offset + t) + c] != want)
-                    fail_check(h, "meshlet %zu triangle %u corner %d: vertex %u, want %u", m, t, c,
-                               corners[3 * (meshlet->triangle_offset + t) + c], want);
-            }
+    meshlet_fetch fetch = gpu_meshlet_fetch(h, &packed, &built, mesh.joint_count, mesh.vertex_count);
+    for (size_t m = 0; m < stats->meshlet_count; ++m) {
+        check_meshlet_vertices(h, &packed, &built, m, fetch.records.mapped);
+        check_meshlet_corners(h, &built, m, fetch.corners.mapped);
     }
-    vkResetDescriptorPool(ctx->device, ctx->descriptor_pool, 0);
-    vkx_buffer* all[] = {&codec_buffer, &words_buffer, &meshlet_buffer, &data_buffer, &records_buffer, &corners_buffer};
-    for (size_t i = 0; i < sizeof(all) / sizeof(all[0]); ++i) vkx_buffer_destroy(ctx, all[i]);
+    vkx_buffer_destroy(&h->ctx, &fetch.records);
+    vkx_buffer_destroy(&h->ctx, &fetch.corners);
     sp_gpu_meshlets_free(&built);
     sp_gpu_default_skin_free(&packed);
     sp_skin_mesh_free(&mesh);
@@ -631,8 +710,7 @@ static float* gpu_skin(harness* h, VkPipeline pipeline, const sp_skin_mesh* mesh
                        const uint32_t* baseline, size_t baseline_words)
 {
     vkx_context* ctx = &h->ctx;
-    vkx_buffer codec_buffer = vkx_buffer_create(ctx, sizeof(*codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1);
-    memcpy(codec_buffer.mapped, codec, sizeof(*codec));
+    vkx_buffer codec_buffer = vkx_host_buffer(ctx, codec, sizeof(*codec), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     vkx_buffer words_buffer = vkx_upload(ctx, words, words ? word_count * 4 : 0, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer lut_buffer = vkx_upload(ctx, lut, lut ? lut_bytes : 0, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vkx_buffer baseline_buffer = vkx_upload(ctx, baseline, baseline ? baseline_words * 4 : 0, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -684,155 +762,194 @@ static double compare_positions(harness* h, const float* got, const float* want,
     return worst;
 }
 
-static void test_mesh(harness* h, const char* path)
-{
+/* A mesh, its K = 4 reference influences skinned in C, and the work arrays of one compressed
+ * configuration. */
+typedef struct mesh_test {
     sp_skin_mesh mesh;
-    sp_skin_mesh_load(path, &mesh);
-    size_t n = mesh.vertex_count;
-    printf("mesh %s: %zu vertices, %u triangles, %u joints\n", mesh.name, n, mesh.triangle_count, mesh.joint_count);
-    double extent = 1e-6;
-    for (size_t i = 0; i < n * 3; ++i) extent = fmax(extent, fabs((double)mesh.positions[i]));
-    const double tolerance = 2e-6 * extent; /* float accumulation vs the double C reference: a few ulps */
+    size_t n;
+    double extent, tolerance;
+    uint16_t* prepared_joints; /* sorted, pruned, renormalised: 4 per vertex */
+    float* prepared_weights;
+    float* reference_original; /* C skinning with the prepared influences */
+    uint32_t* words;
+    uint16_t* lut;
+    uint8_t* lut_bytes;
+    uint16_t* decoded_joints; /* the C decoder's: K per vertex */
+    float* decoded_weights;
+    float* reference_decoded; /* C skinning with the decoded influences */
+    size_t scratch_size;
+    void* scratch;
+} mesh_test;
 
-    /* The reference influences: K = 4 prepared weights (sorted, pruned, renormalised). */
-    uint16_t* prepared_joints = malloc(n * 4 * sizeof(uint16_t));
-    float* prepared_weights = malloc(n * 4 * sizeof(float));
-    if (sp_prepare_influences(mesh.joints, mesh.weights, n, 8, mesh.joint_count, 4, 1e-3f, prepared_joints,
-                              prepared_weights, NULL, NULL) != SP_OK)
+/* Loads the mesh and skins it in C with its prepared influences. */
+static void mesh_test_load(harness* h, mesh_test* t, const char* path)
+{
+    sp_skin_mesh* mesh = &t->mesh;
+    sp_skin_mesh_load(path, mesh);
+    size_t n = t->n = mesh->vertex_count;
+    printf("mesh %s: %zu vertices, %u triangles, %u joints\n", mesh->name, n, mesh->triangle_count, mesh->joint_count);
+    t->extent = 1e-6;
+    for (size_t i = 0; i < n * 3; ++i) t->extent = fmax(t->extent, fabs((double)mesh->positions[i]));
+    t->tolerance = 2e-6 * t->extent; /* float accumulation vs the double C reference: a few ulps */
+
+    t->prepared_joints = malloc(n * 4 * sizeof(uint16_t));
+    t->prepared_weights = malloc(n * 4 * sizeof(float));
+    if (sp_prepare_influences(mesh->joints, mesh->weights, n, 8, mesh->joint_count, 4, 1e-3f, t->prepared_joints,
+                              t->prepared_weights, NULL, NULL) != SP_OK)
         vkx_fail("sp_prepare_influences failed on %s", path);
-    float* reference_original = malloc(n * 3 * sizeof(float));
-    sp_reference_skin(mesh.positions, n, prepared_joints, prepared_weights, 4, mesh.pose_rows, reference_original);
+    t->reference_original = malloc(n * 3 * sizeof(float));
+    sp_reference_skin(mesh->positions, n, t->prepared_joints, t->prepared_weights, 4, mesh->pose_rows, t->reference_original);
     /* How far the pose moves vertices at all: a skinning test in the rest pose would prove nothing. */
     double moved = 0;
-    for (size_t i = 0; i < n * 3; ++i) moved = fmax(moved, fabs((double)reference_original[i] - mesh.positions[i]));
-    printf("  pose moves vertices by up to %.3g (extent %.3g)\n", moved, extent);
-    if (moved < 1e-3 * extent) fail_check(h, "the exported pose barely moves the mesh (%.3g)", moved);
+    for (size_t i = 0; i < n * 3; ++i) moved = fmax(moved, fabs((double)t->reference_original[i] - mesh->positions[i]));
+    printf("  pose moves vertices by up to %.3g (extent %.3g)\n", moved, t->extent);
+    if (moved < 1e-3 * t->extent) fail_check(h, "the exported pose barely moves the mesh (%.3g)", moved);
 
-    /* Float32 baseline: original weights on the GPU vs C. */
+    t->words = malloc(n * 2 * sizeof(uint32_t));
+    t->lut = malloc(n * 4 * sizeof(uint16_t));
+    t->lut_bytes = malloc(n * 4 * sizeof(uint16_t));
+    t->decoded_joints = malloc(n * 4 * sizeof(uint16_t));
+    t->decoded_weights = malloc(n * 4 * sizeof(float));
+    t->reference_decoded = malloc(n * 3 * sizeof(float));
+    t->scratch_size = sp_compress_scratch_bound(n, 8);
+    t->scratch = malloc(t->scratch_size);
+}
+
+static void mesh_test_free(mesh_test* t)
+{
+    void* arrays[] = {t->words, t->lut, t->lut_bytes, t->decoded_joints, t->decoded_weights, t->reference_decoded,
+                      t->reference_original, t->prepared_joints, t->prepared_weights, t->scratch};
+    for (size_t i = 0; i < sizeof(arrays) / sizeof(arrays[0]); ++i) free(arrays[i]);
+    sp_skin_mesh_free(&t->mesh);
+}
+
+/* Float32 baseline: the prepared weights and u8 joints on the GPU vs C. */
+static void check_float32_baseline(harness* h, mesh_test* t)
+{
+    size_t n = t->n;
     uint32_t* baseline = malloc(n * 5 * sizeof(uint32_t));
     for (size_t v = 0; v < n; ++v) {
-        memcpy(&baseline[5 * v], &prepared_weights[4 * v], 4 * sizeof(float));
+        memcpy(&baseline[5 * v], &t->prepared_weights[4 * v], 4 * sizeof(float));
         uint32_t packed_joints = 0;
-        for (int s = 0; s < 4; ++s) packed_joints |= (uint32_t)(prepared_joints[4 * v + s] & 0xff) << (8 * s);
+        for (int s = 0; s < 4; ++s) packed_joints |= (uint32_t)(t->prepared_joints[4 * v + s] & 0xff) << (8 * s);
         baseline[5 * v + 4] = packed_joints;
     }
     SpGpuCodec no_codec;
     memset(&no_codec, 0, sizeof(no_codec));
-    if (mesh.joint_count <= 256) {
+    if (t->mesh.joint_count <= 256) {
         vkx_specialization spec = sp_gpu_specialization(SP_VERTEX_FORMAT_FLOAT32, NULL);
         VkPipeline float_pipeline = vkx_compute_pipeline(&h->ctx, "skin.comp.spv", &spec);
-        float* gpu = gpu_skin(h, float_pipeline, &mesh, &no_codec, NULL, 0, NULL, 0, baseline, n * 5);
-        compare_positions(h, gpu, reference_original, n, tolerance, "float32 weights (original)");
+        float* gpu = gpu_skin(h, float_pipeline, &t->mesh, &no_codec, NULL, 0, NULL, 0, baseline, n * 5);
+        compare_positions(h, gpu, t->reference_original, n, t->tolerance, "float32 weights (original)");
         free(gpu);
         vkDestroyPipeline(h->ctx.device, float_pipeline, NULL);
     }
+    free(baseline);
+}
 
-    /* Compressed: several methods and word sizes, GPU decode + skin vs C decode + skin. */
-    vkx_specialization runtime_spec = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, NULL);
-    VkPipeline runtime_pipeline = vkx_compute_pipeline(&h->ctx, "skin.comp.spv", &runtime_spec);
-    uint32_t* words = malloc(n * 2 * sizeof(uint32_t));
-    uint16_t* lut = malloc(n * 4 * sizeof(uint16_t));
-    uint8_t* lut_bytes = malloc(n * 4 * sizeof(uint16_t));
-    uint16_t* decoded_joints = malloc(n * 4 * sizeof(uint16_t));
-    float* decoded_weights = malloc(n * 4 * sizeof(float));
-    float* reference_decoded = malloc(n * 3 * sizeof(float));
-    size_t scratch_size = sp_compress_scratch_bound(n, 8);
-    void* scratch = malloc(scratch_size);
+/* max_r |M_j p| over the first k joints of vertex v (rows 12 floats a joint). */
+static double pose_reach(const sp_skin_mesh* mesh, const uint16_t* joints, uint32_t k, size_t v)
+{
+    double reach = 0;
+    const float* p = mesh->positions + 3 * v;
+    for (uint32_t s = 0; s < k; ++s) {
+        const float* m = mesh->pose_rows + 12 * (size_t)joints[k * v + s];
+        for (int r = 0; r < 3; ++r)
+            reach = fmax(reach, fabs(m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3]));
+    }
+    return reach;
+}
+
+/* Quantisation effect vs the original weights, bounded per vertex by
+ * sum_i |dw_i| |M_i p| <= K * max_error * max_i |M_i p| (plus float rounding). */
+static void check_quantisation_bound(harness* h, const mesh_test* t, const sp_compressed_skin* skin, const float* gpu,
+                                     const char* label)
+{
+    size_t over = 0;
+    double worst = 0;
+    for (size_t v = 0; v < t->n; ++v) {
+        double reach = fmax(pose_reach(&t->mesh, t->prepared_joints, 4, v),
+                            pose_reach(&t->mesh, t->decoded_joints, skin->influences, v));
+        double bound = 2.0 * 4 * skin->codec.max_error * reach * 1.7320508 + t->tolerance;
+        double d = 0;
+        for (int axis = 0; axis < 3; ++axis)
+            d = fmax(d, fabs((double)gpu[3 * v + axis] - (double)t->reference_original[3 * v + axis]));
+        worst = fmax(worst, d);
+        if (d > bound) ++over;
+    }
+    printf("  %-44s max |decoded - original| = %.3g (codec max_error %.3g)\n", "", worst, skin->codec.max_error);
+    if (over) fail_check(h, "%s: %zu vertices moved more than the codec's error bound allows", label, over);
+}
+
+/* Compresses the skin with the library's C decode of it as reference; returns 0 on failure. */
+static int compress_and_decode(harness* h, mesh_test* t, sp_method method, uint32_t vertex_bits, sp_compressed_skin* skin)
+{
+    const sp_skin_mesh* mesh = &t->mesh;
+    sp_compress_options options;
+    sp_compress_options_default(&options);
+    options.method = method;
+    options.vertex_bits = vertex_bits;
+    sp_result result = sp_compress_skin(mesh->joints, mesh->weights, t->n, 8, mesh->joint_count, &options, t->words, t->lut,
+                                        NULL, NULL, skin, t->scratch, t->scratch_size);
+    if (result != SP_OK) {
+        fail_check(h, "sp_compress_skin(%s, %u bits): %s", sp_method_name(method), vertex_bits, sp_result_string(result));
+        return 0;
+    }
+    result = sp_decompress_skin(&skin->codec, t->words, t->n, skin->tuple_bits, t->lut, skin->lut_size, mesh->joint_count,
+                                t->decoded_joints, t->decoded_weights, NULL);
+    if (result != SP_OK) {
+        fail_check(h, "sp_decompress_skin: %s", sp_result_string(result));
+        return 0;
+    }
+    sp_reference_skin(mesh->positions, t->n, t->decoded_joints, t->decoded_weights, skin->influences, mesh->pose_rows,
+                      t->reference_decoded);
+    return 1;
+}
+
+/* One compressed configuration: GPU decode + skin vs C decode + skin, once with the decoder
+ * chosen at run time from the codec block, once with a pipeline specialised to this codec
+ * (what an engine ships); both must match C. */
+static void check_compressed(harness* h, mesh_test* t, VkPipeline runtime_pipeline, sp_method method, uint32_t vertex_bits)
+{
+    sp_compressed_skin skin;
+    if (!compress_and_decode(h, t, method, vertex_bits, &skin)) return;
+    size_t n = t->n, lut_entries = skin.lut_size * skin.influences;
+    sp_gpu_lut_bytes(t->lut, lut_entries, skin.joint_bytes, t->lut_bytes);
+    SpGpuCodec gpu_codec = sp_gpu_skin_codec(&skin, t->mesh.joint_count);
+    vkx_specialization spec = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, &gpu_codec);
+    VkPipeline specialised_pipeline = vkx_compute_pipeline(&h->ctx, "skin.comp.spv", &spec);
+    char label[96];
+    snprintf(label, sizeof(label), "%s %u-bit budget (%u-bit code + %u-bit tuple)", sp_method_name(method), vertex_bits,
+             skin.weight_bits, skin.tuple_bits);
+    size_t word_count = n * skin.words_per_vertex, lut_bytes = lut_entries * skin.joint_bytes;
+    float* gpu = gpu_skin(h, runtime_pipeline, &t->mesh, &gpu_codec, t->words, word_count, t->lut_bytes, lut_bytes, NULL, 0);
+    compare_positions(h, gpu, t->reference_decoded, n, t->tolerance, label);
+    free(gpu);
+    gpu = gpu_skin(h, specialised_pipeline, &t->mesh, &gpu_codec, t->words, word_count, t->lut_bytes, lut_bytes, NULL, 0);
+    compare_positions(h, gpu, t->reference_decoded, n, t->tolerance,
+                      spec.decoder == SP_SPEC_DECODER_NARROW        ? "  same, specialised 32-bit decoder"
+                      : spec.decoder == SP_SPEC_DECODER_WIDE_ROWS32 ? "  same, specialised 64-bit layer / 32-bit row decoder"
+                                                                    : "  same, specialised 64-bit decoder");
+    vkDestroyPipeline(h->ctx.device, specialised_pipeline, NULL);
+    check_quantisation_bound(h, t, &skin, gpu, label);
+    free(gpu);
+}
+
+static void test_mesh(harness* h, const char* path)
+{
     static const struct { sp_method method; uint32_t vertex_bits; } configs[] = {
         {SP_METHOD_OSS, 32}, {SP_METHOD_OSS, 48}, {SP_METHOD_OSS, 64}, {SP_METHOD_POT, 32}, {SP_METHOD_CUBE, 48},
         {SP_METHOD_FIXED, 64}, {SP_METHOD_ANY, 32},
     };
-    for (size_t c = 0; c < sizeof(configs) / sizeof(configs[0]); ++c) {
-        sp_compress_options options;
-        sp_compress_options_default(&options);
-        options.method = configs[c].method;
-        options.vertex_bits = configs[c].vertex_bits;
-        sp_compressed_skin skin;
-        sp_result result = sp_compress_skin(mesh.joints, mesh.weights, n, 8, mesh.joint_count, &options, words, lut, NULL,
-                                            NULL, &skin, scratch, scratch_size);
-        if (result != SP_OK) {
-            fail_check(h, "sp_compress_skin(%s, %u bits): %s", sp_method_name(configs[c].method), configs[c].vertex_bits,
-                       sp_result_string(result));
-            continue;
-        }
-        uint32_t k = skin.influences;
-        result = sp_decompress_skin(&skin.codec, words, n, skin.tuple_bits, lut, skin.lut_size, mesh.joint_count,
-                                    decoded_joints, decoded_weights, NULL);
-        if (result != SP_OK) {
-            fail_check(h, "sp_decompress_skin: %s", sp_result_string(result));
-            continue;
-        }
-        sp_reference_skin(mesh.positions, n, decoded_joints, decoded_weights, k, mesh.pose_rows, reference_decoded);
-        size_t lut_entries = skin.lut_size * k;
-        for (size_t e = 0; e < lut_entries; ++e) {
-            lut_bytes[skin.joint_bytes * e] = (uint8_t)lut[e];
-            if (skin.joint_bytes == 2) lut_bytes[2 * e + 1] = (uint8_t)(lut[e] >> 8);
-        }
-        SpGpuCodec gpu_codec = sp_gpu_codec_fill(&skin.codec, skin.tuple_bits, skin.words_per_vertex, skin.joint_bytes,
-                                                 (uint32_t)skin.lut_size, mesh.joint_count);
-        /* Once with the decoder chosen at run time from the codec block, once with a pipeline
-         * specialised to this codec (what an engine ships); both must match C. */
-        vkx_specialization spec = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, &gpu_codec);
-        VkPipeline specialised_pipeline = vkx_compute_pipeline(&h->ctx, "skin.comp.spv", &spec);
-        char label[96];
-        snprintf(label, sizeof(label), "%s %u-bit budget (%u-bit code + %u-bit tuple)", sp_method_name(configs[c].method),
-                 configs[c].vertex_bits, skin.weight_bits, skin.tuple_bits);
-        float* gpu = gpu_skin(h, runtime_pipeline, &mesh, &gpu_codec, words, n * skin.words_per_vertex, lut_bytes,
-                              lut_entries * skin.joint_bytes, NULL, 0);
-        compare_positions(h, gpu, reference_decoded, n, tolerance, label);
-        free(gpu);
-        gpu = gpu_skin(h, specialised_pipeline, &mesh, &gpu_codec, words, n * skin.words_per_vertex, lut_bytes,
-                       lut_entries * skin.joint_bytes, NULL, 0);
-        compare_positions(h, gpu, reference_decoded, n, tolerance,
-                          spec.decoder == SP_SPEC_DECODER_NARROW        ? "  same, specialised 32-bit decoder"
-                          : spec.decoder == SP_SPEC_DECODER_WIDE_ROWS32 ? "  same, specialised 64-bit layer / 32-bit row decoder"
-                                                                        : "  same, specialised 64-bit decoder");
-        vkDestroyPipeline(h->ctx.device, specialised_pipeline, NULL);
-
-        /* Quantisation effect vs the original weights, bounded per vertex by
-         * sum_i |dw_i| |M_i p| <= K * max_error * max_i |M_i p| (plus float rounding). */
-        size_t over = 0;
-        double worst = 0;
-        for (size_t v = 0; v < n; ++v) {
-            double reach = 0;
-            for (uint32_t s = 0; s < 4; ++s) {
-                const float* m = mesh.pose_rows + 12 * (size_t)prepared_joints[4 * v + s];
-                for (int r = 0; r < 3; ++r) {
-                    const float* p = mesh.positions + 3 * v;
-                    reach = fmax(reach, fabs(m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3]));
-                }
-            }
-            for (uint32_t s = 0; s < k; ++s) {
-                const float* m = mesh.pose_rows + 12 * (size_t)decoded_joints[k * v + s];
-                for (int r = 0; r < 3; ++r) {
-                    const float* p = mesh.positions + 3 * v;
-                    reach = fmax(reach, fabs(m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3]));
-                }
-            }
-            double bound = 2.0 * 4 * skin.codec.max_error * reach * 1.7320508 + tolerance;
-            double d = 0;
-            for (int axis = 0; axis < 3; ++axis)
-                d = fmax(d, fabs((double)gpu[3 * v + axis] - (double)reference_original[3 * v + axis]));
-            worst = fmax(worst, d);
-            if (d > bound) ++over;
-        }
-        printf("  %-44s max |decoded - original| = %.3g (codec max_error %.3g)\n", "", worst, skin.codec.max_error);
-        if (over) fail_check(h, "%s: %zu vertices moved more than the codec's error bound allows", label, over);
-        free(gpu);
-    }
+    mesh_test t;
+    mesh_test_load(h, &t, path);
+    check_float32_baseline(h, &t);
+    vkx_specialization runtime_spec = sp_gpu_specialization(SP_VERTEX_FORMAT_PACKED, NULL);
+    VkPipeline runtime_pipeline = vkx_compute_pipeline(&h->ctx, "skin.comp.spv", &runtime_spec);
+    for (size_t c = 0; c < sizeof(configs) / sizeof(configs[0]); ++c)
+        check_compressed(h, &t, runtime_pipeline, configs[c].method, configs[c].vertex_bits);
     vkDestroyPipeline(h->ctx.device, runtime_pipeline, NULL);
-    free(words);
-    free(lut);
-    free(lut_bytes);
-    free(decoded_joints);
-    free(decoded_weights);
-    free(reference_decoded);
-    free(reference_original);
-    free(prepared_joints);
-    free(prepared_weights);
-    free(baseline);
-    free(scratch);
-    sp_skin_mesh_free(&mesh);
+    mesh_test_free(&t);
 }
 
 int main(int argc, char** argv)

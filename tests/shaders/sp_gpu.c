@@ -248,10 +248,21 @@ void sp_gpu_default_skin_build(const sp_skin_mesh* mesh, sp_gpu_default_skin* ou
                            out->joints, out->weights, NULL) != SP_OK)
         vkx_fail("%s: compress/decompress failed", mesh->name);
     free(scratch);
-    for (size_t e = 0; e < skin->lut_size * skin->influences; ++e) {
-        out->lut_bytes[skin->joint_bytes * e] = (uint8_t)out->lut[e];
-        if (skin->joint_bytes == 2) out->lut_bytes[2 * e + 1] = (uint8_t)(out->lut[e] >> 8);
+    sp_gpu_lut_bytes(out->lut, skin->lut_size * skin->influences, skin->joint_bytes, out->lut_bytes);
+}
+
+void sp_gpu_lut_bytes(const uint16_t* lut, size_t entries, uint32_t joint_bytes, uint8_t* out)
+{
+    for (size_t e = 0; e < entries; ++e) {
+        out[joint_bytes * e] = (uint8_t)lut[e];
+        if (joint_bytes == 2) out[2 * e + 1] = (uint8_t)(lut[e] >> 8);
     }
+}
+
+SpGpuCodec sp_gpu_skin_codec(const sp_compressed_skin* skin, uint32_t joint_count)
+{
+    return sp_gpu_codec_fill(&skin->codec, skin->tuple_bits, skin->words_per_vertex, skin->joint_bytes,
+                             (uint32_t)skin->lut_size, joint_count);
 }
 
 void sp_gpu_default_skin_free(sp_gpu_default_skin* packed)

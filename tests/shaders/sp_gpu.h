@@ -16,6 +16,11 @@
 SpGpuCodec sp_gpu_codec_fill(const sp_codec* codec, uint32_t tuple_bits, uint32_t words_per_vertex,
                              uint32_t joint_bytes, uint32_t lut_size, uint32_t joint_count);
 
+/* sp_gpu_codec_fill for a compressed skin of joint_count joints. */
+SpGpuCodec sp_gpu_skin_codec(const sp_compressed_skin* skin, uint32_t joint_count);
+/* The tuple LUT as the shaders read it: joint_bytes (1 or 2) bytes an entry, little-endian. */
+void sp_gpu_lut_bytes(const uint16_t* lut, size_t entries, uint32_t joint_bytes, uint8_t* out);
+
 /* Specialisation for a vertex format; with a codec (PACKED), also its method, K and decoder,
  * so the pipeline holds only the decoder that codec needs. codec NULL: all runtime. */
 vkx_specialization sp_gpu_specialization(uint32_t vertex_format, const SpGpuCodec* codec);

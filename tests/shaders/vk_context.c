@@ -74,9 +74,8 @@ static void create_descriptor_layouts(vkx_context* ctx)
     VKX_CHECK(vkCreateDescriptorPool(ctx->device, &pool_info, NULL, &ctx->descriptor_pool));
 }
 
-void vkx_create(vkx_context* ctx, int want_mesh_shader)
+static void create_instance(vkx_context* ctx)
 {
-    memset(ctx, 0, sizeof(*ctx));
     VkApplicationInfo app = {
         .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
         .pApplicationName = "skinpack",
@@ -86,7 +85,12 @@ void vkx_create(vkx_context* ctx, int want_mesh_shader)
     VkResult result = vkCreateInstance(&instance_info, NULL, &ctx->instance);
     if (result != VK_SUCCESS)
         vkx_fail("vkCreateInstance returned %d: no Vulkan driver (install mesa-vulkan-drivers for lavapipe)", (int)result);
+}
 
+/* The first physical device, or the first discrete GPU if there is one; fails when it is not
+ * the one SKINPACK_EXPECT_DEVICE names or has no Vulkan 1.3. */
+static void pick_physical_device(vkx_context* ctx)
+{
     uint32_t count = 0;
     vkEnumeratePhysicalDevices(ctx->instance, &count, NULL);
     if (count == 0) vkx_fail("no Vulkan physical device (VK_ICD_FILENAMES=%s)", getenv("VK_ICD_FILENAMES") ? getenv("VK_ICD_FILENAMES") : "unset");
@@ -110,7 +114,11 @@ void vkx_create(vkx_context* ctx, int want_mesh_shader)
     if (VK_API_VERSION_MINOR(ctx->properties.apiVersion) < 3 && VK_API_VERSION_MAJOR(ctx->properties.apiVersion) == 1)
         vkx_fail("device \"%s\" has Vulkan 1.%u; 1.3 is needed (dynamic rendering)", ctx->properties.deviceName,
                  VK_API_VERSION_MINOR(ctx->properties.apiVersion));
+}
 
+/* One queue does everything, and the benchmark times it: graphics + compute + timestamps. */
+static void pick_queue_family(vkx_context* ctx)
+{
     uint32_t family_count = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_device, &family_count, NULL);
     VkQueueFamilyProperties families[16];
@@ -125,7 +133,11 @@ void vkx_create(vkx_context* ctx, int want_mesh_shader)
         }
     }
     if (ctx->queue_family == UINT32_MAX) vkx_fail("no graphics+compute queue with timestamps");
+}
 
+/* The device with dynamic rendering, and VK_EXT_mesh_shader when wanted and there. */
+static void create_device(vkx_context* ctx, int want_mesh_shader)
+{
     ctx->has_mesh_shader = want_mesh_shader && has_extension(ctx->physical_device, VK_EXT_MESH_SHADER_EXTENSION_NAME);
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh_features = {
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT,
@@ -157,7 +169,15 @@ void vkx_create(vkx_context* ctx, int want_mesh_shader)
     vkGetDeviceQueue(ctx->device, ctx->queue_family, 0, &ctx->queue);
     if (ctx->has_mesh_shader)
         ctx->draw_mesh_tasks = (PFN_vkCmdDrawMeshTasksEXT)vkGetDeviceProcAddr(ctx->device, "vkCmdDrawMeshTasksEXT");
+}
 
+void vkx_create(vkx_context* ctx, int want_mesh_shader)
+{
+    memset(ctx, 0, sizeof(*ctx));
+    create_instance(ctx);
+    pick_physical_device(ctx);
+    pick_queue_family(ctx);
+    create_device(ctx, want_mesh_shader);
     VkCommandPoolCreateInfo pool_info = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
         .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
@@ -185,6 +205,18 @@ static uint32_t memory_type(vkx_context* ctx, uint32_t allowed, VkMemoryProperty
     vkx_fail("no memory type with properties 0x%x", (unsigned)want);
 }
 
+static VkDeviceMemory allocate_memory(vkx_context* ctx, const VkMemoryRequirements* requirements, VkMemoryPropertyFlags want)
+{
+    VkMemoryAllocateInfo allocate = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = requirements->size,
+        .memoryTypeIndex = memory_type(ctx, requirements->memoryTypeBits, want),
+    };
+    VkDeviceMemory memory;
+    VKX_CHECK(vkAllocateMemory(ctx->device, &allocate, NULL, &memory));
+    return memory;
+}
+
 vkx_buffer vkx_buffer_create(vkx_context* ctx, VkDeviceSize size, VkBufferUsageFlags usage, int host_visible)
 {
     vkx_buffer buffer = {0};
@@ -199,12 +231,7 @@ vkx_buffer vkx_buffer_create(vkx_context* ctx, VkDeviceSize size, VkBufferUsageF
     vkGetBufferMemoryRequirements(ctx->device, buffer.buffer, &requirements);
     VkMemoryPropertyFlags want = host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                               : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    VkMemoryAllocateInfo allocate = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-        .allocationSize = requirements.size,
-        .memoryTypeIndex = memory_type(ctx, requirements.memoryTypeBits, want),
-    };
-    VKX_CHECK(vkAllocateMemory(ctx->device, &allocate, NULL, &buffer.memory));
+    buffer.memory = allocate_memory(ctx, &requirements, want);
     VKX_CHECK(vkBindBufferMemory(ctx->device, buffer.buffer, buffer.memory, 0));
     if (host_visible) VKX_CHECK(vkMapMemory(ctx->device, buffer.memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped));
     return buffer;
@@ -229,6 +256,20 @@ vkx_buffer vkx_upload(vkx_context* ctx, const void* data, size_t size, VkBufferU
     vkCmdCopyBuffer(cmd, staging.buffer, buffer.buffer, 1, &region);
     vkx_submit_and_wait(ctx, cmd);
     vkx_buffer_destroy(ctx, &staging);
+    return buffer;
+}
+
+vkx_buffer vkx_host_buffer(vkx_context* ctx, const void* data, size_t size, VkBufferUsageFlags usage)
+{
+    vkx_buffer buffer = vkx_buffer_create(ctx, size, usage, 1);
+    memcpy(buffer.mapped, data, size);
+    return buffer;
+}
+
+vkx_buffer vkx_poisoned_buffer(vkx_context* ctx, VkDeviceSize size, VkBufferUsageFlags usage)
+{
+    vkx_buffer buffer = vkx_buffer_create(ctx, size, usage, 1);
+    memset(buffer.mapped, 0xcd, buffer.size);
     return buffer;
 }
 
@@ -316,6 +357,66 @@ VkPipeline vkx_compute_pipeline(vkx_context* ctx, const char* shader_file, const
     return pipeline;
 }
 
+/* The fixed-function state of vkx_graphics_pipeline, kept together because the create info
+ * points into it. */
+typedef struct graphics_state {
+    VkPipelineVertexInputStateCreateInfo vertex_input;
+    VkPipelineInputAssemblyStateCreateInfo assembly;
+    VkPipelineViewportStateCreateInfo viewport;
+    VkPipelineRasterizationStateCreateInfo raster;
+    VkPipelineMultisampleStateCreateInfo multisample;
+    VkPipelineDepthStencilStateCreateInfo depth;
+    VkPipelineColorBlendAttachmentState blend_attachment;
+    VkPipelineColorBlendStateCreateInfo blend;
+    VkDynamicState dynamic_states[2];
+    VkPipelineDynamicStateCreateInfo dynamic;
+} graphics_state;
+
+/* Triangle lists, dynamic viewport and scissor, back faces culled, depth test, no blending. */
+static void graphics_state_init(graphics_state* s)
+{
+    s->vertex_input = (VkPipelineVertexInputStateCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    s->assembly = (VkPipelineInputAssemblyStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+    };
+    s->viewport = (VkPipelineViewportStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+        .viewportCount = 1,
+        .scissorCount = 1,
+    };
+    s->raster = (VkPipelineRasterizationStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+        .polygonMode = VK_POLYGON_MODE_FILL,
+        .cullMode = VK_CULL_MODE_BACK_BIT,
+        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+        .lineWidth = 1.0f,
+    };
+    s->multisample = (VkPipelineMultisampleStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+    };
+    s->depth = (VkPipelineDepthStencilStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+        .depthTestEnable = VK_TRUE,
+        .depthWriteEnable = VK_TRUE,
+        .depthCompareOp = VK_COMPARE_OP_LESS,
+    };
+    s->blend_attachment = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
+    s->blend = (VkPipelineColorBlendStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+        .attachmentCount = 1,
+        .pAttachments = &s->blend_attachment,
+    };
+    s->dynamic_states[0] = VK_DYNAMIC_STATE_VIEWPORT;
+    s->dynamic_states[1] = VK_DYNAMIC_STATE_SCISSOR;
+    s->dynamic = (VkPipelineDynamicStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+        .dynamicStateCount = 2,
+        .pDynamicStates = s->dynamic_states,
+    };
+}
+
 VkPipeline vkx_graphics_pipeline(vkx_context* ctx, const char* first_stage_file, int mesh, const vkx_specialization* spec,
                                  VkFormat color_format, VkFormat depth_format)
 {
@@ -335,64 +436,28 @@ VkPipeline vkx_graphics_pipeline(vkx_context* ctx, const char* first_stage_file,
             .pName = "main",
         },
     };
-    VkPipelineVertexInputStateCreateInfo vertex_input = {.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    VkPipelineInputAssemblyStateCreateInfo assembly = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-    };
-    VkPipelineViewportStateCreateInfo viewport = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-        .viewportCount = 1,
-        .scissorCount = 1,
-    };
-    VkPipelineRasterizationStateCreateInfo raster = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-        .polygonMode = VK_POLYGON_MODE_FILL,
-        .cullMode = VK_CULL_MODE_BACK_BIT,
-        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
-        .lineWidth = 1.0f,
-    };
-    VkPipelineMultisampleStateCreateInfo multisample = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
-    };
-    VkPipelineDepthStencilStateCreateInfo depth = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-        .depthTestEnable = VK_TRUE,
-        .depthWriteEnable = VK_TRUE,
-        .depthCompareOp = VK_COMPARE_OP_LESS,
-    };
-    VkPipelineColorBlendAttachmentState blend_attachment = {.colorWriteMask = 0xf};
-    VkPipelineColorBlendStateCreateInfo blend = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-        .attachmentCount = 1,
-        .pAttachments = &blend_attachment,
-    };
-    VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dynamic = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-        .dynamicStateCount = 2,
-        .pDynamicStates = dynamic_states,
-    };
+    graphics_state state;
+    graphics_state_init(&state);
     VkPipelineRenderingCreateInfo rendering = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
         .colorAttachmentCount = 1,
         .pColorAttachmentFormats = &color_format,
         .depthAttachmentFormat = depth_format,
     };
+    /* A mesh shader makes its own primitives: no vertex input, no input assembly. */
     VkGraphicsPipelineCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
         .pNext = &rendering,
         .stageCount = 2,
         .pStages = stages,
-        .pVertexInputState = mesh ? NULL : &vertex_input,
-        .pInputAssemblyState = mesh ? NULL : &assembly,
-        .pViewportState = &viewport,
-        .pRasterizationState = &raster,
-        .pMultisampleState = &multisample,
-        .pDepthStencilState = &depth,
-        .pColorBlendState = &blend,
-        .pDynamicState = &dynamic,
+        .pVertexInputState = mesh ? NULL : &state.vertex_input,
+        .pInputAssemblyState = mesh ? NULL : &state.assembly,
+        .pViewportState = &state.viewport,
+        .pRasterizationState = &state.raster,
+        .pMultisampleState = &state.multisample,
+        .pDepthStencilState = &state.depth,
+        .pColorBlendState = &state.blend,
+        .pDynamicState = &state.dynamic,
         .layout = ctx->pipeline_layout,
     };
     VkPipeline pipeline;
@@ -437,12 +502,32 @@ void vkx_dispatch_and_wait(vkx_context* ctx, VkPipeline pipeline, VkDescriptorSe
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &set, 0, NULL);
     vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_ALL, 0, push_size, push);
     vkCmdDispatch(cmd, groups_x, groups_y, 1);
-    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                               .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-                               .dstAccessMask = VK_ACCESS_HOST_READ_BIT};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
-                         0, NULL);
+    vkx_cmd_memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                           VK_ACCESS_HOST_READ_BIT);
     vkx_submit_and_wait(ctx, cmd);
+}
+
+void vkx_cmd_memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkPipelineStageFlags dst_stage,
+                            VkAccessFlags src_access, VkAccessFlags dst_access)
+{
+    VkMemoryBarrier barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER, .srcAccessMask = src_access, .dstAccessMask = dst_access};
+    vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &barrier, 0, NULL, 0, NULL);
+}
+
+VkImageMemoryBarrier vkx_image_barrier(const vkx_image* image, VkImageAspectFlags aspect, VkAccessFlags src_access,
+                                       VkAccessFlags dst_access, VkImageLayout old_layout, VkImageLayout new_layout)
+{
+    return (VkImageMemoryBarrier){
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = src_access,
+        .dstAccessMask = dst_access,
+        .oldLayout = old_layout,
+        .newLayout = new_layout,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = image->image,
+        .subresourceRange = {aspect, 0, 1, 0, 1},
+    };
 }
 
 vkx_image vkx_image_create(vkx_context* ctx, uint32_t width, uint32_t height, VkFormat format, VkImageUsageFlags usage,
@@ -463,12 +548,7 @@ vkx_image vkx_image_create(vkx_context* ctx, uint32_t width, uint32_t height, Vk
     VKX_CHECK(vkCreateImage(ctx->device, &info, NULL, &image.image));
     VkMemoryRequirements requirements;
     vkGetImageMemoryRequirements(ctx->device, image.image, &requirements);
-    VkMemoryAllocateInfo allocate = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-        .allocationSize = requirements.size,
-        .memoryTypeIndex = memory_type(ctx, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
-    };
-    VKX_CHECK(vkAllocateMemory(ctx->device, &allocate, NULL, &image.memory));
+    image.memory = allocate_memory(ctx, &requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     VKX_CHECK(vkBindImageMemory(ctx->device, image.image, image.memory, 0));
     VkImageViewCreateInfo view = {
         .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
@@ -486,4 +566,17 @@ void vkx_image_destroy(vkx_context* ctx, vkx_image* image)
     vkDestroyImageView(ctx->device, image->view, NULL);
     vkDestroyImage(ctx->device, image->image, NULL);
     vkFreeMemory(ctx->device, image->memory, NULL);
+}
+
+VkRenderingAttachmentInfo vkx_cleared_attachment(const vkx_image* image, VkImageLayout layout, VkAttachmentStoreOp store,
+                                                 VkClearValue clear)
+{
+    return (VkRenderingAttachmentInfo){
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = image->view,
+        .imageLayout = layout,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = store,
+        .clearValue = clear,
+    };
 }

@@ -1,7 +1,8 @@
 /*
  * vk_context.h - the minimal headless Vulkan plumbing shared by the shader harness and the GPU
  * benchmark: one device and queue, buffers, the skinpack descriptor set (bindings of
- * shaders/skinpack_gpu_layout.h), compute and graphics pipelines, one-shot command buffers.
+ * shaders/skinpack_gpu_layout.h), compute and graphics pipelines, one-shot command buffers,
+ * the barriers and attachments of a render pass.
  * Every failure prints what failed and exits(1): a test that cannot reach Vulkan fails.
  */
 #ifndef SKINPACK_VK_CONTEXT_H
@@ -62,6 +63,12 @@ void vkx_buffer_destroy(vkx_context* ctx, vkx_buffer* buffer);
 /* A device-local storage buffer holding a copy of data. */
 vkx_buffer vkx_upload(vkx_context* ctx, const void* data, size_t size, VkBufferUsageFlags usage);
 
+/* A host-visible buffer holding a copy of data (a uniform block the tests write once). */
+vkx_buffer vkx_host_buffer(vkx_context* ctx, const void* data, size_t size, VkBufferUsageFlags usage);
+/* A host-visible output buffer filled with 0xcd bytes, so that whatever a shader fails to write
+ * cannot pass a check. */
+vkx_buffer vkx_poisoned_buffer(vkx_context* ctx, VkDeviceSize size, VkBufferUsageFlags usage);
+
 /* One descriptor set of the shared layout. buffers[b] for each binding b < SP_BINDING_COUNT;
  * NULL entries get a small dummy buffer. Binding 0 is a uniform buffer, the rest storage. */
 VkDescriptorSet vkx_descriptor_set(vkx_context* ctx, vkx_buffer* const buffers[SP_BINDING_COUNT], vkx_buffer* dummy);
@@ -99,5 +106,15 @@ typedef struct vkx_image {
 vkx_image vkx_image_create(vkx_context* ctx, uint32_t width, uint32_t height, VkFormat format, VkImageUsageFlags usage,
                            VkImageAspectFlags aspect);
 void vkx_image_destroy(vkx_context* ctx, vkx_image* image);
+
+/* vkCmdPipelineBarrier with one global memory barrier. */
+void vkx_cmd_memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkPipelineStageFlags dst_stage,
+                            VkAccessFlags src_access, VkAccessFlags dst_access);
+/* A layout transition of the image's one mip level and layer, no queue family transfer. */
+VkImageMemoryBarrier vkx_image_barrier(const vkx_image* image, VkImageAspectFlags aspect, VkAccessFlags src_access,
+                                       VkAccessFlags dst_access, VkImageLayout old_layout, VkImageLayout new_layout);
+/* An attachment of dynamic rendering in layout, cleared to clear on load. */
+VkRenderingAttachmentInfo vkx_cleared_attachment(const vkx_image* image, VkImageLayout layout, VkAttachmentStoreOp store,
+                                                 VkClearValue clear);
 
 #endif
