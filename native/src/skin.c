@@ -120,7 +120,7 @@ static void narrow_influences(uint16_t* joints, float* weights, size_t vertex_co
         }
 }
 
-/* The option checks of sp_compress_skin: exactly one budget, finite limits, K in range. */
+/* The option checks of sp_compress_skin: exactly one budget, no negative (or NaN) limit, K in range. */
 static int compress_options_valid(const sp_compress_options* options)
 {
     int budgets = (options->vertex_bits != 0) + (options->weight_bits != 0) + (options->max_spacing > 0) +
