@@ -574,5 +574,49 @@ SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_la
     put8(layout, out, head);
     put4(layout, out + 8, _mm256_castps256_ps128(tail));
 }
+/* ---- the edge codes (codec_oss_simd.h's edge_decode) ------------------------------------ */
+
+/* u_at_least's bound for n (n - 1, biased: the compare is signed and strict; n >= 1). */
+SP_INLINE SIMD_FN uvec u_bound(uint64_t n) { return _mm256_set1_epi64x((int64_t)((n - 1) ^ (uint64_t)INT64_MIN)); }
+
+/* The lanes of a at least n (u_bound(n)), unsigned, as bits. */
+SP_INLINE SIMD_FN unsigned u_at_least(uvec a, uvec bound)
+{
+    __m256i biased = _mm256_xor_si256(a, _mm256_set1_epi64x(INT64_MIN));
+    return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(biased, bound)));
+}
+
+/* The lanes of a and of at set in keep, in order, to the front of codes and positions (a whole
+ * block written to each). The permutes come from a table of the 16 lane sets: lane l of the
+ * result takes the 32-bit halves 2m, 2m + 1 of the l-th lane kept. */
+SP_INLINE SIMD_FN void u_compact(uvec a, uvec at, unsigned keep, uint64_t* codes, uint64_t* positions)
+{
+    static const int32_t order[16][8] = {
+        {0, 1, 0, 1, 0, 1, 0, 1}, {0, 1, 0, 1, 0, 1, 0, 1}, {2, 3, 0, 1, 0, 1, 0, 1}, {0, 1, 2, 3, 0, 1, 0, 1},
+        {4, 5, 0, 1, 0, 1, 0, 1}, {0, 1, 4, 5, 0, 1, 0, 1}, {2, 3, 4, 5, 0, 1, 0, 1}, {0, 1, 2, 3, 4, 5, 0, 1},
+        {6, 7, 0, 1, 0, 1, 0, 1}, {0, 1, 6, 7, 0, 1, 0, 1}, {2, 3, 6, 7, 0, 1, 0, 1}, {0, 1, 2, 3, 6, 7, 0, 1},
+        {4, 5, 6, 7, 0, 1, 0, 1}, {0, 1, 4, 5, 6, 7, 0, 1}, {2, 3, 4, 5, 6, 7, 0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}};
+    __m256i permute = _mm256_loadu_si256((const __m256i*)order[keep & 15]);
+    _mm256_storeu_si256((__m256i*)codes, _mm256_permutevar8x32_epi32(a, permute));
+    _mm256_storeu_si256((__m256i*)positions, _mm256_permutevar8x32_epi32(at, permute));
+}
+
+/* The first two weights of four vertices of k floats (the doubles' roundings to float), each
+ * row's others left as they are. */
+SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float* out)
+{
+    __m128 a = _mm256_cvtpd_ps(first), b = _mm256_cvtpd_ps(second);
+    __m128 low = _mm_unpacklo_ps(a, b), high = _mm_unpackhi_ps(a, b);
+    _mm_storel_pi((__m64*)out, low);
+    _mm_storeh_pi((__m64*)(out + k), low);
+    _mm_storel_pi((__m64*)(out + 2 * k), high);
+    _mm_storeh_pi((__m64*)(out + 3 * k), high);
+}
+
+/* Vertex positions first, first + 1, ... of a block. */
+SP_INLINE SIMD_FN uvec u_positions(uint64_t first)
+{
+    return _mm256_add_epi64(_mm256_set1_epi64x((int64_t)first), _mm256_setr_epi64x(0, 1, 2, 3));
+}
 #endif
 #endif

@@ -417,5 +417,46 @@ SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_la
 {
     store_weights(q, 3, inverse, layout, out);
 }
+/* ---- the edge codes (codec_oss_simd.h's edge_decode) ------------------------------------ */
+
+/* u_at_least's bound for n. */
+SP_INLINE SIMD_FN uvec u_bound(uint64_t n) { return _mm512_set1_epi64((int64_t)n); }
+
+/* The lanes of a at least n (u_bound(n)), unsigned, as bits. */
+SP_INLINE SIMD_FN unsigned u_at_least(uvec a, uvec bound) { return _mm512_cmpge_epu64_mask(a, bound); }
+
+/* The lanes of a and of at set in keep, in order, to the front of codes and positions (a whole
+ * block written to each). */
+SP_INLINE SIMD_FN void u_compact(uvec a, uvec at, unsigned keep, uint64_t* codes, uint64_t* positions)
+{
+    _mm512_storeu_si512(codes, _mm512_maskz_compress_epi64((__mmask8)keep, a));
+    _mm512_storeu_si512(positions, _mm512_maskz_compress_epi64((__mmask8)keep, at));
+}
+
+/* The first two weights of eight vertices of k floats (the doubles' roundings to float), each
+ * row's others left as they are: two-source permutes into the rows' places, stored under masks
+ * of those places (K = 3: float p of the rows is vertex p / 3's weight p % 3, none where 2). */
+SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float* out)
+{
+    __m256 a = _mm512_cvtpd_ps(first), b = _mm512_cvtpd_ps(second);
+    __m512 wide_a = _mm512_castps256_ps512(a), wide_b = _mm512_castps256_ps512(b);
+    if (k == 4) {
+        __m512i low = _mm512_setr_epi32(0, 16, 0, 0, 1, 17, 0, 0, 2, 18, 0, 0, 3, 19, 0, 0);
+        __m512i high = _mm512_setr_epi32(4, 20, 0, 0, 5, 21, 0, 0, 6, 22, 0, 0, 7, 23, 0, 0);
+        _mm512_mask_storeu_ps(out, 0x3333, _mm512_permutex2var_ps(wide_a, low, wide_b));
+        _mm512_mask_storeu_ps(out + 16, 0x3333, _mm512_permutex2var_ps(wide_a, high, wide_b));
+    } else {
+        __m512i head = _mm512_setr_epi32(0, 16, 0, 1, 17, 0, 2, 18, 0, 3, 19, 0, 4, 20, 0, 5);
+        __m256i tail = _mm256_setr_epi32(13, 0, 6, 14, 0, 7, 15, 0); /* floats 16-23: a's are 0-7, b's 8-15 */
+        _mm512_mask_storeu_ps(out, 0xB6DB, _mm512_permutex2var_ps(wide_a, head, wide_b));
+        _mm256_mask_storeu_ps(out + 16, 0x6D, _mm256_permutex2var_ps(a, tail, b));
+    }
+}
+
+/* Vertex positions first, first + 1, ... of a block. */
+SP_INLINE SIMD_FN uvec u_positions(uint64_t first)
+{
+    return _mm512_add_epi64(_mm512_set1_epi64((int64_t)first), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+}
 #endif
 #endif

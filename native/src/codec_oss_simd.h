@@ -871,18 +871,195 @@ SP_INLINE SIMD_FN int decode_chunk_split(const sp_codec* codec, const void* cons
 
 DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0)
 
+/* ---- the edge codes: vertices of one or two weights -------------------------------------- */
+
+/*
+ * For K = 3 and 4 the codes below N are the first row of the first layer, q = (2(N - 1) - c, c,
+ * 0, 0): the grid points on the edge between the simplex's first two corners, every vertex with
+ * at most two weights. Real meshes are mostly such vertices (the paper's mix: 73 %), and each
+ * decodes by one subtraction, where the others take the layer and row roots. So a chunk of
+ * EDGE_CHUNK codes whose first EDGE_SAMPLE hold at least EDGE_MIN of them is decoded in two
+ * passes: every lane as if it held an edge code, into a buffer whose other weights are zeros,
+ * while the other codes are compacted into a list (and every code checked); then the list, by
+ * the driver's own walk, whose weights are put over those lanes' wrong ones, and the buffer goes
+ * to the weights. Every lane's weights are what the driver (so the scalar code) gives it.
+ */
+#define EDGE_CHUNK 256
+#define EDGE_SAMPLE 32
+#define EDGE_MIN (EDGE_SAMPLE / 4)
+#define EDGE_LIST (EDGE_CHUNK + 2 * NBLOCK) /* room for a whole block stored past the last code kept, and the padding */
+
+/* A chunk's buffer: its rows (past each row's first two weights zero while unused) and the
+ * vertices whose rows the list's weights took (to be zeroed again). */
+typedef struct edge_buffer {
+    float rows[EDGE_CHUNK * SP_MAX_INFLUENCES];
+    uint64_t at[EDGE_LIST];
+    size_t count;
+} edge_buffer;
+
+/* The other codes of a chunk, their weights, and two chunk buffers: each chunk's buffer goes to
+ * the weights during the next chunk's first pass, so that its stores spread over that pass
+ * instead of leaving the chunk at once (AVX2, 1M vertices streamed: ~1.1x). */
+typedef struct edge_list {
+    uint64_t codes[EDGE_LIST];
+    float weights[EDGE_LIST * SP_MAX_INFLUENCES];
+    edge_buffer buffer[2];
+    size_t padded;       /* codes in the list rounded up to NBLOCK lanes */
+    unsigned filling;    /* the buffer the next chunk fills */
+    float* pending;      /* where the other buffer's rows go, or NULL */
+} edge_list;
+
+/* Whether edge codes are decoded apart: past the narrow lanes, K = 4 and (least_k 3) K = 3.
+ * Elsewhere the other codes' decode is too cheap to pay for the two passes (the bench's mix, 1M
+ * vertices: K = 4 in narrow lanes 0.9x as fast on AVX-512, K = 3 in wide lanes 0.8x on AVX2,
+ * 0.7x on AVX-512; every K = 2 code is an edge code). */
+SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k, uint32_t least_k)
+{
+    return k >= least_k && k > 2 && !narrow_decode(codec, k);
+}
+
+/* The set bits of a block's lanes (BLOCK <= 8). */
+SP_INLINE unsigned lane_count(unsigned bits)
+{
+    static const uint8_t nibble[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    return BLOCK == 4 ? nibble[bits] : nibble[bits & 15] + nibble[bits >> 4 & 15];
+}
+
+/* Whether a chunk's first codes hold enough edge codes. */
+SP_INLINE SIMD_FN int edge_chunk_pays(const uint64_t* codes, uint64_t n)
+{
+    unsigned edges = 0;
+    uvec bound = u_bound(n);
+    for (size_t v = 0; v < EDGE_SAMPLE; v += BLOCK) edges += lane_count(u_at_least(u_load(codes + v), bound));
+    return EDGE_SAMPLE - edges >= EDGE_MIN;
+}
+
+/* Floats [from, to) of rows to out, in whole 8-float stores. */
+SP_INLINE SIMD_FN void edge_send(const float* rows, size_t from, size_t to, const simd_layout* layout, float* out)
+{
+    for (size_t i = (from + 7) / 8 * 8; i < to; i += 8) put8(layout, out + i, _mm256_loadu_ps(rows + i));
+}
+
+/* The pending buffer's rows that the list's weights took back to zero past the first two, and
+ * nothing pending. */
+SP_INLINE SIMD_FN void edge_sent(edge_list* list, uint32_t k)
+{
+    edge_buffer* sent = &list->buffer[list->filling ^ 1];
+    for (size_t i = 0; i < sent->count; ++i) memset(sent->rows + sent->at[i] * k + 2, 0, (k - 2) * sizeof(float));
+    list->pending = NULL;
+}
+
+/* The pending buffer (if any) to the weights at once. */
+SP_INLINE SIMD_FN void edge_flush(edge_list* list, uint32_t k, const simd_layout* layout)
+{
+    if (!list->pending) return;
+    edge_send(list->buffer[list->filling ^ 1].rows, 0, EDGE_CHUNK * k, layout, list->pending);
+    edge_sent(list, k);
+}
+
+/* Every lane of a chunk decoded as an edge code into the filling buffer, the other codes listed
+ * with their vertices and padded with copies of the last to whole NBLOCK lanes, the pending
+ * buffer sent meanwhile. The edge code's weights are sp_grid_to_weights' (c < N is exact, and so
+ * is 2(N - 1) - c). No code is checked: an edge code is valid, and the driver's walk checks the
+ * list. Locals for everything the stores could alias. */
+SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, uint32_t k, const simd_layout* layout,
+                                  edge_list* list)
+{
+    vec inverse = v_splat(1.0 / (double)codec->scale), scale = v_splat((double)codec->scale);
+    uvec bound = u_bound(codec->n), at = u_positions(0), step = u_splat(BLOCK);
+    edge_buffer* filling = &list->buffer[list->filling];
+    float *rows = filling->rows, *pending = list->pending;
+    const float* sending = list->buffer[list->filling ^ 1].rows;
+    uint64_t *listed_codes = list->codes, *listed_at = filling->at;
+    size_t listed = 0;
+    for (size_t v = 0; v < EDGE_CHUNK; v += BLOCK) {
+        prefetch_ahead(codes + v, sizeof(uint64_t), BLOCK);
+        uvec code = u_load(codes + v);
+        vec c = v_from_u(code); /* exact below 2^52, so for every edge code */
+        unsigned others = u_at_least(code, bound);
+        store_edge_pairs(v_mul(v_sub(scale, c), inverse), v_mul(c, inverse), k, rows + v * k);
+        u_compact(code, at, others, listed_codes + listed, listed_at + listed);
+        listed += lane_count(others);
+        at = u_add(at, step);
+        if (pending && k * BLOCK % 8 == 0) /* whole stores a block (constants: the tests fold) */
+            for (size_t i = 0; i < k * BLOCK; i += 8) put8(layout, pending + v * k + i, _mm256_loadu_ps(sending + v * k + i));
+        else if (pending && v % (2 * BLOCK)) /* K = 3 on AVX2: whole stores every other block */
+            for (size_t i = 0; i < 2 * k * BLOCK; i += 8)
+                put8(layout, pending + (v - BLOCK) * k + i, _mm256_loadu_ps(sending + (v - BLOCK) * k + i));
+    }
+    if (pending) edge_sent(list, k);
+    filling->count = listed;
+    for (list->padded = listed; list->padded % NBLOCK; ++list->padded) list->codes[list->padded] = list->codes[listed - 1];
+}
+
+/* The list's weights (the chunk's other codes') over their rows in the filling buffer, which
+ * then waits to go to out. */
+SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
+{
+    edge_buffer* filling = &list->buffer[list->filling];
+    for (size_t i = 0; i < filling->count; ++i)
+        memcpy(filling->rows + filling->at[i] * k, list->weights + i * k, k * sizeof(float));
+    list->pending = out;
+    list->filling ^= 1;
+}
+
+/* A hook for the tests (test_batch_edges.c), which count the chunks decoded in two passes. */
+#ifndef EDGE_TWO_PASSES
+#define EDGE_TWO_PASSES() ((void)0)
+#endif
+
+/* `name`: `range` (a driver's decode of count codes from codes[0], returning where it stopped)
+ * over chunks of EDGE_CHUNK codes, those holding enough edge codes in two passes (above), for
+ * K >= least_k. */
+#define DEFINE_EDGE_DECODE(name, range, least_k)                                                                       \
+    SP_INLINE SIMD_FN size_t name(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t count,   \
+                                  float* weights, uint32_t k, const simd_layout* layout)                               \
+    {                                                                                                                  \
+        if (!edge_decode(codec, k, least_k) || count < EDGE_CHUNK)                                                    \
+            return range(codec, constants, codes, count, weights, k, layout);                                          \
+        edge_list list;                                                                                                \
+        memset(list.buffer, 0, sizeof list.buffer);                                                                    \
+        list.filling = 0, list.pending = NULL;                                                                         \
+        simd_layout plain = *layout;                                                                                   \
+        plain.stream = 0;                                                                                              \
+        for (size_t v = 0; v < count; v += EDGE_CHUNK) {                                                               \
+            size_t chunk = count - v < EDGE_CHUNK ? count - v : EDGE_CHUNK, done;                                      \
+            const uint64_t* in = codes + v;                                                                            \
+            if (chunk == EDGE_CHUNK && edge_chunk_pays(in, codec->n)) {                                                \
+                edge_split(codec, in, k, layout, &list);                                                               \
+                if (range(codec, constants, list.codes, list.padded, list.weights, k, &plain) == list.padded) {       \
+                    edge_merge(&list, k, weights + v * k);                                                             \
+                    EDGE_TWO_PASSES();                                                                                 \
+                    continue;                                                                                          \
+                }                                                                                                      \
+            } /* else, or where the list holds an invalid code, the chunk as it is */                                 \
+            edge_flush(&list, k, layout);                                                                              \
+            if ((done = range(codec, constants, in, chunk, weights + v * k, k, layout)) < chunk) return v + done;      \
+        }                                                                                                              \
+        edge_flush(&list, k, layout);                                                                                  \
+        return count;                                                                                                  \
+    }
+
 /* The narrow chunks (narrow codecs) or the split ones (K = 4 up to SPLIT_MAX_N4) up to the
  * first one holding an invalid code, then the double lanes from there to the end or to the
  * block holding it. */
+SP_INLINE SIMD_FN size_t decode_range(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t count,
+                                      float* weights, uint32_t k, const simd_layout* layout)
+{
+    size_t v = 0;
+    if (narrow_decode(codec, k)) v = decode_walk_narrow(codec, constants, codes, 0, count, weights, k, layout);
+    else if (split_decode(codec, k)) v = decode_walk_split(codec, constants, codes, 0, count, weights, k, layout);
+    return decode_walk(codec, constants, codes, v, count, weights, k, layout);
+}
+
+DEFINE_EDGE_DECODE(decode_edges, decode_range, 3)
+
 SP_INLINE SIMD_FN size_t decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                       size_t count, float* weights, int stream, uint32_t k)
 {
     simd_layout layout = layout_for(k);
     layout.stream = stream;
-    size_t v = 0;
-    if (narrow_decode(codec, k)) v = decode_walk_narrow(codec, constants, codes, 0, count, weights, k, &layout);
-    else if (split_decode(codec, k)) v = decode_walk_split(codec, constants, codes, 0, count, weights, k, &layout);
-    v = decode_walk(codec, constants, codes, v, count, weights, k, &layout);
+    size_t v = decode_edges(codec, constants, codes, count, weights, k, &layout);
     if (layout.stream) _mm_sfence(); /* the streamed lines ordered before whatever the caller publishes next */
     return v;
 }

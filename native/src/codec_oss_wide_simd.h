@@ -553,17 +553,24 @@ SP_INLINE SIMD_FN int wide_decode_chunk(const sp_codec* codec, const void* const
 
 DEFINE_DECODE_WALK(wide_decode_walk, wide_decode_chunk, BLOCK, DECODE_CHUNK, 1)
 
-/* The chunks to the end or to the block holding an invalid code; stream a constant in each
- * call, as in decode_blocks. */
+/* The chunks to the end or to the block holding an invalid code. */
+SP_INLINE SIMD_FN size_t wide_decode_range(const sp_codec* codec, const void* constants, const uint64_t* codes,
+                                           size_t count, float* weights, uint32_t k, const simd_layout* layout)
+{
+    if (k == 4 && codec->max_code < WIDE_WHOLE_CODES) return wide_decode_walk4_whole(codec, constants, codes, 0, count, weights, k, layout);
+    if (k == 4) return wide_decode_walk4(codec, constants, codes, 0, count, weights, k, layout);
+    return wide_decode_walk(codec, constants, codes, 0, count, weights, k, layout);
+}
+
+DEFINE_EDGE_DECODE(wide_decode_edges, wide_decode_range, 4) /* K = 3's wide lanes: one pass (edge_decode) */
+
+/* stream a constant in each call, as in decode_blocks */
 SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                            size_t count, float* weights, int stream, uint32_t k)
 {
     simd_layout layout = layout_for(k);
     layout.stream = stream;
-    size_t v;
-    if (k == 4 && codec->max_code < WIDE_WHOLE_CODES) v = wide_decode_walk4_whole(codec, constants, codes, 0, count, weights, k, &layout);
-    else if (k == 4) v = wide_decode_walk4(codec, constants, codes, 0, count, weights, k, &layout);
-    else v = wide_decode_walk(codec, constants, codes, 0, count, weights, k, &layout);
+    size_t v = wide_decode_edges(codec, constants, codes, count, weights, k, &layout);
     if (stream) _mm_sfence(); /* as decode_lanes */
     return v;
 }
