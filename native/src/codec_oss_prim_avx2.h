@@ -586,10 +586,10 @@ SP_INLINE SIMD_FN unsigned u_at_least(uvec a, uvec bound)
     return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(biased, bound)));
 }
 
-/* The lanes of a and of at set in keep, in order, to the front of codes and positions (a whole
- * block written to each). The permutes come from a table of the 16 lane sets: lane l of the
- * result takes the 32-bit halves 2m, 2m + 1 of the l-th lane kept. */
-SP_INLINE SIMD_FN void u_compact(uvec a, uvec at, unsigned keep, uint64_t* codes, uint64_t* positions)
+/* The lanes of a set in keep, in order, to the front of out (a whole block written). The
+ * permutes come from a table of the 16 lane sets: lane l of the result takes the 32-bit halves
+ * 2m, 2m + 1 of the l-th lane kept. */
+SP_INLINE SIMD_FN void u_compact(uvec a, unsigned keep, uint64_t* out)
 {
     static const int32_t order[16][8] = {
         {0, 1, 0, 1, 0, 1, 0, 1}, {0, 1, 0, 1, 0, 1, 0, 1}, {2, 3, 0, 1, 0, 1, 0, 1}, {0, 1, 2, 3, 0, 1, 0, 1},
@@ -597,8 +597,7 @@ SP_INLINE SIMD_FN void u_compact(uvec a, uvec at, unsigned keep, uint64_t* codes
         {6, 7, 0, 1, 0, 1, 0, 1}, {0, 1, 6, 7, 0, 1, 0, 1}, {2, 3, 6, 7, 0, 1, 0, 1}, {0, 1, 2, 3, 6, 7, 0, 1},
         {4, 5, 6, 7, 0, 1, 0, 1}, {0, 1, 4, 5, 6, 7, 0, 1}, {2, 3, 4, 5, 6, 7, 0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}};
     __m256i permute = _mm256_loadu_si256((const __m256i*)order[keep & 15]);
-    _mm256_storeu_si256((__m256i*)codes, _mm256_permutevar8x32_epi32(a, permute));
-    _mm256_storeu_si256((__m256i*)positions, _mm256_permutevar8x32_epi32(at, permute));
+    _mm256_storeu_si256((__m256i*)out, _mm256_permutevar8x32_epi32(a, permute));
 }
 
 /* The first two weights of four vertices of k floats (the doubles' roundings to float), each

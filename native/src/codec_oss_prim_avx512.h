@@ -425,12 +425,10 @@ SP_INLINE SIMD_FN uvec u_bound(uint64_t n) { return _mm512_set1_epi64((int64_t)n
 /* The lanes of a at least n (u_bound(n)), unsigned, as bits. */
 SP_INLINE SIMD_FN unsigned u_at_least(uvec a, uvec bound) { return _mm512_cmpge_epu64_mask(a, bound); }
 
-/* The lanes of a and of at set in keep, in order, to the front of codes and positions (a whole
- * block written to each). */
-SP_INLINE SIMD_FN void u_compact(uvec a, uvec at, unsigned keep, uint64_t* codes, uint64_t* positions)
+/* The lanes of a set in keep, in order, to the front of out (a whole block written). */
+SP_INLINE SIMD_FN void u_compact(uvec a, unsigned keep, uint64_t* out)
 {
-    _mm512_storeu_si512(codes, _mm512_maskz_compress_epi64((__mmask8)keep, a));
-    _mm512_storeu_si512(positions, _mm512_maskz_compress_epi64((__mmask8)keep, at));
+    _mm512_storeu_si512(out, _mm512_maskz_compress_epi64((__mmask8)keep, a));
 }
 
 /* The first two weights of eight vertices of k floats (the doubles' roundings to float), each

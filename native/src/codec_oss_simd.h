@@ -880,14 +880,32 @@ DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0
  * decodes by one subtraction, where the others take the layer and row roots. So a chunk of
  * EDGE_CHUNK codes whose first EDGE_SAMPLE hold at least EDGE_MIN of them is decoded in two
  * passes: every lane as if it held an edge code, into a buffer whose other weights are zeros,
- * while the other codes are compacted into a list (and every code checked); then the list, by
- * the driver's own walk, whose weights are put over those lanes' wrong ones, and the buffer goes
- * to the weights. Every lane's weights are what the driver (so the scalar code) gives it.
+ * while the other codes are compacted into a list; then the list, by the driver's own walk
+ * (which checks its codes: edge codes are valid), whose weights are put over those lanes' wrong
+ * ones. The buffer goes to the weights during the next chunk's first pass. Every lane's weights
+ * are what the driver (so the scalar code) gives it. The bench's mix, 1M vertices, against one
+ * pass: AVX2 K = 4 1.3-1.4x as fast past 32-bit codes, AVX-512 K = 4 1.2-1.3x at 52 and 64 bits
+ * (docs/benchmarks.md, session 10). Encode gains nothing from the same split (tried: a K = 4
+ * vertex of two weights still takes the load, division and floors that most of its time goes
+ * to; AVX2 0.9x as fast).
  */
+
 #define EDGE_CHUNK 256
 #define EDGE_SAMPLE 32
 #define EDGE_MIN (EDGE_SAMPLE / 4)
 #define EDGE_LIST (EDGE_CHUNK + 2 * NBLOCK) /* room for a whole block stored past the last code kept, and the padding */
+
+/* The set bits of a block's lanes (BLOCK <= 8). */
+SP_INLINE unsigned lane_count(unsigned bits)
+{
+    static const uint8_t nibble[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    return BLOCK == 4 ? nibble[bits] : nibble[bits & 15] + nibble[bits >> 4 & 15];
+}
+
+/* A hook for the tests (test_batch_edges.c), which count the chunks decoded in two passes. */
+#ifndef EDGE_TWO_PASSES
+#define EDGE_TWO_PASSES() ((void)0)
+#endif
 
 /* A chunk's buffer: its rows (past each row's first two weights zero while unused) and the
  * vertices whose rows the list's weights took (to be zeroed again). */
@@ -918,12 +936,6 @@ SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k, uint32_t least_k)
     return k >= least_k && k > 2 && !narrow_decode(codec, k);
 }
 
-/* The set bits of a block's lanes (BLOCK <= 8). */
-SP_INLINE unsigned lane_count(unsigned bits)
-{
-    static const uint8_t nibble[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-    return BLOCK == 4 ? nibble[bits] : nibble[bits & 15] + nibble[bits >> 4 & 15];
-}
 
 /* Whether a chunk's first codes hold enough edge codes. */
 SP_INLINE SIMD_FN int edge_chunk_pays(const uint64_t* codes, uint64_t n)
@@ -978,7 +990,8 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
         vec c = v_from_u(code); /* exact below 2^52, so for every edge code */
         unsigned others = u_at_least(code, bound);
         store_edge_pairs(v_mul(v_sub(scale, c), inverse), v_mul(c, inverse), k, rows + v * k);
-        u_compact(code, at, others, listed_codes + listed, listed_at + listed);
+        u_compact(code, others, listed_codes + listed);
+        u_compact(at, others, listed_at + listed);
         listed += lane_count(others);
         at = u_add(at, step);
         if (pending && k * BLOCK % 8 == 0) /* whole stores a block (constants: the tests fold) */
@@ -1003,10 +1016,6 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
     list->filling ^= 1;
 }
 
-/* A hook for the tests (test_batch_edges.c), which count the chunks decoded in two passes. */
-#ifndef EDGE_TWO_PASSES
-#define EDGE_TWO_PASSES() ((void)0)
-#endif
 
 /* `name`: `range` (a driver's decode of count codes from codes[0], returning where it stopped)
  * over chunks of EDGE_CHUNK codes, those holding enough edge codes in two passes (above), for
