@@ -574,6 +574,7 @@ SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_la
     put8(layout, out, head);
     put4(layout, out + 8, _mm256_castps256_ps128(tail));
 }
+
 /* ---- the edge codes (codec_oss_simd.h's edge_decode) ------------------------------------ */
 
 /* u_at_least's bound for n (n - 1, biased: the compare is signed and strict; n >= 1). */

@@ -417,6 +417,7 @@ SP_INLINE SIMD_FN void store_triples(const vec* q, double inverse, const simd_la
 {
     store_weights(q, 3, inverse, layout, out);
 }
+
 /* ---- the edge codes (codec_oss_simd.h's edge_decode) ------------------------------------ */
 
 /* u_at_least's bound for n. */

@@ -38,6 +38,10 @@
  *   check_passed, store_counts (lane values as bytes), codes_valid (every code of a block
  *   <= max_code)
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
+ *   for the edge codes' decode: u_bound(n) and u_at_least(a, bound) (the lanes of a >= n, as
+ *   bits), u_compact(a, keep, out) (the lanes kept, in order, to the front of out),
+ *   u_positions(first), store_edge_pairs(first, second, k, out) (two weights a row, the rest of
+ *   each row left)
  * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
  *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
@@ -936,20 +940,13 @@ SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k, uint32_t least_k)
     return k >= least_k && k > 2 && !narrow_decode(codec, k);
 }
 
-
 /* Whether a chunk's first codes hold enough edge codes. */
 SP_INLINE SIMD_FN int edge_chunk_pays(const uint64_t* codes, uint64_t n)
 {
-    unsigned edges = 0;
+    unsigned others = 0;
     uvec bound = u_bound(n);
-    for (size_t v = 0; v < EDGE_SAMPLE; v += BLOCK) edges += lane_count(u_at_least(u_load(codes + v), bound));
-    return EDGE_SAMPLE - edges >= EDGE_MIN;
-}
-
-/* Floats [from, to) of rows to out, in whole 8-float stores. */
-SP_INLINE SIMD_FN void edge_send(const float* rows, size_t from, size_t to, const simd_layout* layout, float* out)
-{
-    for (size_t i = (from + 7) / 8 * 8; i < to; i += 8) put8(layout, out + i, _mm256_loadu_ps(rows + i));
+    for (size_t v = 0; v < EDGE_SAMPLE; v += BLOCK) others += lane_count(u_at_least(u_load(codes + v), bound));
+    return EDGE_SAMPLE - others >= EDGE_MIN;
 }
 
 /* The pending buffer's rows that the list's weights took back to zero past the first two, and
@@ -961,11 +958,12 @@ SP_INLINE SIMD_FN void edge_sent(edge_list* list, uint32_t k)
     list->pending = NULL;
 }
 
-/* The pending buffer (if any) to the weights at once. */
+/* The pending buffer (if any) to the weights at once (EDGE_CHUNK k floats: whole 8-float stores). */
 SP_INLINE SIMD_FN void edge_flush(edge_list* list, uint32_t k, const simd_layout* layout)
 {
     if (!list->pending) return;
-    edge_send(list->buffer[list->filling ^ 1].rows, 0, EDGE_CHUNK * k, layout, list->pending);
+    const float* rows = list->buffer[list->filling ^ 1].rows;
+    for (size_t i = 0; i < EDGE_CHUNK * k; i += 8) put8(layout, list->pending + i, _mm256_loadu_ps(rows + i));
     edge_sent(list, k);
 }
 
@@ -1015,7 +1013,6 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
     list->pending = out;
     list->filling ^= 1;
 }
-
 
 /* `name`: `range` (a driver's decode of count codes from codes[0], returning where it stopped)
  * over chunks of EDGE_CHUNK codes, those holding enough edge codes in two passes (above), for
