@@ -5,12 +5,13 @@
  * chunks that take the two passes counted (EDGE_TWO_PASSES), so a path that silently stopped
  * taking them fails here, not only one that decodes wrongly. For every kind of K = 4 lanes past
  * the narrow ones (split, double, wide with whole codes, wide up to 64-bit codes) and K = 3's
- * double lanes: the bench's
- * share of edge codes (3 in 4, the edges N - 1 and N among them) in full chunks and a tail,
- * with normal and with streaming stores, bit-identical to sp_decode_weights and nothing written
- * past the batch; an invalid code in a chunk's list or at its first vertex, where the walk must
- * stop before it with every vertex up to there decoded; few edge codes, narrow lanes and K = 3's
- * wide ones, which must keep the one-pass walk (edge_decode, edge_chunk_pays).
+ * double lanes: the bench's share of edge codes (3 in 4, the edges N - 1 and N among them) in
+ * full chunks and a tail, with normal and with streaming stores, bit-identical to
+ * sp_decode_weights and nothing written past the batch, also through the library's dispatch at
+ * every 4-byte offset from a line; an invalid code in a chunk's list or at its first vertex,
+ * where the walk must stop before it with every vertex up to there decoded; few edge codes,
+ * narrow lanes and K = 3's wide ones, which must keep the one-pass walk (edge_decode,
+ * edge_chunk_pays).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -122,6 +123,38 @@ static void invalid_at(const sp_codec* c, size_t at)
     free(w), free(codes);
 }
 
+/* The library's own dispatch (codec_oss_batch.c) at every 4-byte offset from a cache line,
+ * streaming from the first line start (its threshold lowered to 0) or not: every vertex
+ * bit-identical, nothing written outside the batch. */
+static void offsets(const sp_codec* c)
+{
+    uint32_t k = c->influences;
+    uint64_t* codes = malloc(COUNT * sizeof(uint64_t));
+    float* ref = malloc(COUNT * k * sizeof(float));
+    make_codes(c, 3, codes, COUNT);
+    for (size_t v = 0; v < COUNT; ++v) sp_decode_weights(c, codes[v], ref + v * k);
+    size_t bytes = COUNT * k * sizeof(float), room = GUARD + 64 + bytes + GUARD;
+    unsigned char* buffer = aligned_alloc(64, (room + 63) / 64 * 64);
+    for (size_t offset = 0; offset < 64; offset += 4)
+        for (size_t min_bytes = 0; min_bytes <= bytes + 1; min_bytes += bytes + 1) { /* streamed, then not */
+            memset(buffer, 0xA5, room);
+            float* w = (float*)(buffer + GUARD + offset);
+            size_t streamed = 0;
+            size_t done = sp_oss_decode_batch_streaming(c, codes, COUNT, w, LANES_ISA, min_bytes, &streamed);
+            CHECK(sp_oss_decode_scalar(c, codes, done, COUNT, w) == COUNT);
+            CHECK_MSG(memcmp(w, ref, bytes) == 0, "K=%u N=%llu offset %zu min_bytes %zu", k, (unsigned long long)c->n,
+                      offset, min_bytes);
+            int line = 0; /* a vertex within a line's worth starts a line: the dispatch streams from there */
+            for (size_t v = 0; v < 16; ++v) line |= !((uintptr_t)(w + v * k) % 64);
+            CHECK_MSG(min_bytes || !line ? !streamed : streamed > 0, "K=%u offset %zu min_bytes %zu: %zu streamed", k,
+                      offset, min_bytes, streamed);
+            for (size_t i = 0; i < GUARD; ++i)
+                CHECK_MSG(buffer[i] == 0xA5 && buffer[GUARD + offset + bytes + i] == 0xA5,
+                          "K=%u N=%llu offset %zu: a byte outside the batch written", k, (unsigned long long)c->n, offset);
+        }
+    free(buffer), free(ref), free(codes);
+}
+
 /* Where the chunks must keep the one-pass walk: codes mostly past the first row, narrow lanes,
  * K = 3's wide lanes; each still decoded right. */
 static void one_pass(const sp_codec* c, unsigned edges)
@@ -152,6 +185,7 @@ int main(void)
         invalid_at(&codecs[i], 3 * EDGE_CHUNK + 77);
         invalid_at(&codecs[i], 2 * EDGE_CHUNK);
         one_pass(&codecs[i], 0);
+        offsets(&codecs[i]);
     }
     sp_codec narrow = oss(4, 1000), narrow_rows = oss(3, 5000), wide_rows = oss(3, (uint64_t)1 << 26);
     one_pass(&narrow, 3);
