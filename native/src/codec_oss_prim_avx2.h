@@ -613,10 +613,7 @@ SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float
     _mm_storeh_pi((__m64*)(out + 3 * k), high);
 }
 
-/* Vertex positions first, first + 1, ... of a block. */
-SP_INLINE SIMD_FN uvec u_positions(uint64_t first)
-{
-    return _mm256_add_epi64(_mm256_set1_epi64x((int64_t)first), _mm256_setr_epi64x(0, 1, 2, 3));
-}
+/* The lanes' numbers 0, 1, ... of a block. */
+SP_INLINE SIMD_FN uvec u_lane_numbers(void) { return _mm256_setr_epi64x(0, 1, 2, 3); }
 #endif
 #endif

@@ -452,10 +452,7 @@ SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float
     }
 }
 
-/* Vertex positions first, first + 1, ... of a block. */
-SP_INLINE SIMD_FN uvec u_positions(uint64_t first)
-{
-    return _mm512_add_epi64(_mm512_set1_epi64((int64_t)first), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
-}
+/* The lanes' numbers 0, 1, ... of a block. */
+SP_INLINE SIMD_FN uvec u_lane_numbers(void) { return _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7); }
 #endif
 #endif

@@ -40,7 +40,7 @@
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
  *   for the edge codes' decode: u_bound(n) and u_at_least(a, bound) (the lanes of a >= n, as
  *   bits), u_compact(a, keep, out) (the lanes kept, in order, to the front of out),
- *   u_positions(first), store_edge_pairs(first, second, k, out) (two weights a row, the rest of
+ *   u_lane_numbers() (0, 1, ... BLOCK - 1), store_edge_pairs(first, second, k, out) (two weights a row, the rest of
  *   each row left)
  * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
  *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
@@ -929,15 +929,17 @@ typedef struct edge_list {
     size_t padded;       /* codes in the list rounded up to NBLOCK lanes */
     unsigned filling;    /* the buffer the next chunk fills */
     float* pending;      /* where the other buffer's rows go, or NULL */
+    int zeroed;          /* whether the buffers' rows are zero past their first two weights yet */
 } edge_list;
 
-/* Whether edge codes are decoded apart: past the narrow lanes, K = 4 and (least_k 3) K = 3.
+/* Whether edge codes are decoded apart: past the narrow lanes, K = 4 and (least_k 3, never
+ * below) K = 3.
  * Elsewhere the other codes' decode is too cheap to pay for the two passes (the bench's mix, 1M
  * vertices: K = 4 in narrow lanes 0.9x as fast on AVX-512, K = 3 in wide lanes 0.8x on AVX2,
  * 0.7x on AVX-512; every K = 2 code is an edge code). */
 SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k, uint32_t least_k)
 {
-    return k >= least_k && k > 2 && !narrow_decode(codec, k);
+    return k >= least_k && !narrow_decode(codec, k);
 }
 
 /* Whether a chunk's first codes hold enough edge codes. */
@@ -976,7 +978,11 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
                                   edge_list* list)
 {
     vec inverse = v_splat(1.0 / (double)codec->scale), scale = v_splat((double)codec->scale);
-    uvec bound = u_bound(codec->n), at = u_positions(0), step = u_splat(BLOCK);
+    uvec bound = u_bound(codec->n), at = u_lane_numbers(), step = u_splat(BLOCK);
+    if (!list->zeroed) { /* the first chunk that pays, not every call: most batches of odd codes have none */
+        for (unsigned b = 0; b < 2; ++b) memset(list->buffer[b].rows, 0, sizeof list->buffer[b].rows);
+        list->zeroed = 1;
+    }
     edge_buffer* filling = &list->buffer[list->filling];
     float *rows = filling->rows, *pending = list->pending;
     const float* sending = list->buffer[list->filling ^ 1].rows;
@@ -1024,8 +1030,7 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
         if (!edge_decode(codec, k, least_k) || count < EDGE_CHUNK)                                                    \
             return range(codec, constants, codes, count, weights, k, layout);                                          \
         edge_list list;                                                                                                \
-        memset(list.buffer, 0, sizeof list.buffer);                                                                    \
-        list.filling = 0, list.pending = NULL;                                                                         \
+        list.filling = 0, list.pending = NULL, list.zeroed = 0;                                                        \
         simd_layout plain = *layout;                                                                                   \
         plain.stream = 0;                                                                                              \
         for (size_t v = 0; v < count; v += EDGE_CHUNK) {                                                               \
