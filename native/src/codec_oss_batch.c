@@ -78,13 +78,6 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 #define STREAM_MIN_BYTES ((size_t)4 << 20)
 #define STREAM_LINE 64
 
-/* Whether streaming pays for these lanes: not K = 3's wide ones (past N = 2^24), bound by their
- * arithmetic, which ran 0.92-1.0x as fast streaming (AVX2; AVX-512 0.99-1.04x). */
-static int stream_pays(oss_lanes lanes, uint32_t k)
-{
-    return !(lanes == LANES_WIDE && k == 3);
-}
-
 /* How many vertices precede the first one whose weights start a cache line, so that the
  * streaming stores from there write whole lines (and AVX-512's are aligned); count if none does
  * within a line's worth (K = 4 weights not 16-byte aligned, K = 2 ones not 8-byte aligned). */
@@ -108,7 +101,7 @@ size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* code
     sp_oss_decode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
     sp_oss_decode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
     int large = count * k * sizeof(float) >= stream_min_bytes;
-    size_t head = large && stream_pays(lanes, k) ? stream_head(weights, k, count) : count;
+    size_t head = large ? stream_head(weights, k, count) : count;
     int stream = head < count;
     if (stream) { /* the head by the scalar code, which stops at an invalid code (the caller reports it) */
         done = sp_oss_decode_scalar(codec, codes, 0, head, weights);
@@ -118,8 +111,7 @@ size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* code
     if (done < count) done += avx2(codec, codes + done, count - done, weights + done * k, stream);
     if (streamed && stream) *streamed = done - head;
 #else
-    (void)codec, (void)codes, (void)count, (void)weights, (void)widest, (void)stream_min_bytes, (void)stream_head,
-        (void)stream_pays;
+    (void)codec, (void)codes, (void)count, (void)weights, (void)widest, (void)stream_min_bytes, (void)stream_head;
 #endif
     return done;
 }

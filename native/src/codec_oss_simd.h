@@ -889,9 +889,13 @@ DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0
  * ones. The buffer goes to the weights during the next chunk's first pass. Every lane's weights
  * are what the driver (so the scalar code) gives it. The bench's mix, 1M vertices, against one
  * pass: AVX2 K = 4 1.3-1.4x as fast past 32-bit codes, AVX-512 K = 4 1.2-1.3x at 52 and 64 bits
- * (docs/benchmarks.md, session 10). Encode gains nothing from the same split (tried: a K = 4
- * vertex of two weights still takes the load, division and floors that most of its time goes
- * to; AVX2 0.9x as fast).
+ * (docs/benchmarks.md, session 10); K = 3 in wide lanes AVX2 ~1.2x, AVX-512 ~1.1x (session 11).
+ * The first pass runs through its chunk several times as fast as the walk, too fast for lines
+ * read for ownership: where the weights do not stream (codec_oss_batch.c), each of its stores
+ * waited on one, and K = 3's wide lanes, whose one-pass decode hides that, ran 0.8x as fast in
+ * two passes (session 10, before they streamed). Encode gains nothing from the same split
+ * (tried: a K = 4 vertex of two weights still takes the load, division and floors that most of
+ * its time goes to; AVX2 0.9x as fast).
  */
 
 #define EDGE_CHUNK 256
@@ -932,14 +936,12 @@ typedef struct edge_list {
     int zeroed;          /* whether the buffers' rows are zero past their first two weights yet */
 } edge_list;
 
-/* Whether edge codes are decoded apart: past the narrow lanes, K = 4 and (least_k 3, never
- * below) K = 3.
- * Elsewhere the other codes' decode is too cheap to pay for the two passes (the bench's mix, 1M
- * vertices: K = 4 in narrow lanes 0.9x as fast on AVX-512, K = 3 in wide lanes 0.8x on AVX2,
- * 0.7x on AVX-512; every K = 2 code is an edge code). */
-SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k, uint32_t least_k)
+/* Whether edge codes are decoded apart: K = 3 and 4 past the narrow lanes. In those the other
+ * codes' decode is too cheap to pay for the two passes (the bench's mix, 1M vertices: K = 4 0.9x
+ * as fast on AVX-512); every K = 2 code is an edge code. */
+SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k)
 {
-    return k >= least_k && !narrow_decode(codec, k);
+    return k >= 3 && !narrow_decode(codec, k);
 }
 
 /* Whether a chunk's first codes hold enough edge codes. */
@@ -1021,13 +1023,13 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
 }
 
 /* `name`: `range` (a driver's decode of count codes from codes[0], returning where it stopped)
- * over chunks of EDGE_CHUNK codes, those holding enough edge codes in two passes (above), for
- * K >= least_k. */
-#define DEFINE_EDGE_DECODE(name, range, least_k)                                                                       \
+ * over chunks of EDGE_CHUNK codes, those holding enough edge codes in two passes (above), where
+ * edge_decode. */
+#define DEFINE_EDGE_DECODE(name, range)                                                                                \
     SP_INLINE SIMD_FN size_t name(const sp_codec* codec, const void* constants, const uint64_t* codes, size_t count,   \
                                   float* weights, uint32_t k, const simd_layout* layout)                               \
     {                                                                                                                  \
-        if (!edge_decode(codec, k, least_k) || count < EDGE_CHUNK)                                                    \
+        if (!edge_decode(codec, k) || count < EDGE_CHUNK)                                                             \
             return range(codec, constants, codes, count, weights, k, layout);                                          \
         edge_list list;                                                                                                \
         list.filling = 0, list.pending = NULL, list.zeroed = 0;                                                        \
@@ -1063,7 +1065,7 @@ SP_INLINE SIMD_FN size_t decode_range(const sp_codec* codec, const void* constan
     return decode_walk(codec, constants, codes, v, count, weights, k, layout);
 }
 
-DEFINE_EDGE_DECODE(decode_edges, decode_range, 3)
+DEFINE_EDGE_DECODE(decode_edges, decode_range)
 
 SP_INLINE SIMD_FN size_t decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,
                                       size_t count, float* weights, int stream, uint32_t k)

@@ -562,7 +562,7 @@ SP_INLINE SIMD_FN size_t wide_decode_range(const sp_codec* codec, const void* co
     return wide_decode_walk(codec, constants, codes, 0, count, weights, k, layout);
 }
 
-DEFINE_EDGE_DECODE(wide_decode_edges, wide_decode_range, 4) /* K = 3's wide lanes: one pass (edge_decode) */
+DEFINE_EDGE_DECODE(wide_decode_edges, wide_decode_range)
 
 /* stream a constant in each call, as in decode_blocks */
 SP_INLINE SIMD_FN size_t wide_decode_lanes(const sp_codec* codec, const void* constants, const uint64_t* codes,

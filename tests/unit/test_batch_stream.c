@@ -2,8 +2,7 @@
  * The decode's streaming stores (codec_oss_batch.c's sp_oss_decode_batch_streaming, the
  * primitives' put8 and the like) against the scalar code, bit for bit, once per vector path the
  * CPU has: the threshold lowered so small batches stream, for K = 2, 3, 4 and every kind of lanes
- * (narrow, split, double, wide; K = 3's wide ones checked to keep normal stores, as
- * codec_oss_batch.c's stream_pays has them), outputs at every 4-byte offset from a cache line, random codes
+ * (narrow, split, double, wide), outputs at every 4-byte offset from a cache line, random codes
  * (the wide and split lanes send some to the scalar redo, which rewrites streamed lines), tails
  * and invalid codes. A path that silently stops streaming fails the count of streamed vertices;
  * one that streams to the wrong place, past the batch or before it fails the comparison and the
@@ -26,12 +25,6 @@ static sp_codec oss(uint32_t k, uint64_t n)
     sp_codec c;
     CHECK(sp_codec_from_params(SP_METHOD_OSS, k, n, NULL, &c) == SP_OK);
     return c;
-}
-
-/* Whether the dispatch streams this codec's decode: not K = 3's wide lanes (past N = 2^24). */
-static int streams(const sp_codec* c)
-{
-    return !(c->influences == 3 && c->n > ((uint64_t)1 << 24));
 }
 
 /* The vertices before the first whose weights start a 64-byte line (what the dispatch decodes
@@ -61,7 +54,7 @@ static size_t decode_at(const sp_codec* c, const uint64_t* codes, size_t count, 
     for (size_t i = 0; i < GUARD + offset; ++i) CHECK(buffer[i] == 0xA5);
     for (size_t i = GUARD + offset + bytes; i < GUARD + offset + bytes + GUARD; ++i) CHECK(buffer[i] == 0xA5);
     size_t head = expected_head(weights, k, count);
-    CHECK_MSG(streamed == (bytes >= min_bytes && head < count && streams(c) ? done - head : 0),
+    CHECK_MSG(streamed == (bytes >= min_bytes && head < count ? done - head : 0),
               "isa %d K=%u N=%llu offset %zu: %zu streamed of %zu done, head %zu", (int)widest, k,
               (unsigned long long)c->n, offset, streamed, done, head);
     free(buffer);
@@ -79,7 +72,7 @@ static void check_offsets(const sp_codec* c, size_t count)
     CHECK(sp_decode_weights_batch_isa(c, codes, count, ref, NULL, SP_ISA_SCALAR) == SP_OK);
     size_t streamed = 0;
     for (size_t offset = 0; offset < 64; offset += 4) streamed += decode_at(c, codes, count, offset, 0, ref);
-    CHECK_MSG(streams(c) ? streamed >= count / 2 : streamed == 0, "isa %d K=%u N=%llu: %zu streamed", (int)widest, k, (unsigned long long)c->n, streamed);
+    CHECK_MSG(streamed >= count / 2, "isa %d K=%u N=%llu: %zu streamed", (int)widest, k, (unsigned long long)c->n, streamed);
     free(codes), free(ref);
 }
 
