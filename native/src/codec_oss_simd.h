@@ -890,12 +890,13 @@ DEFINE_DECODE_WALK(decode_walk_split, decode_chunk_split, NBLOCK, SPLIT_CHUNK, 0
  * are what the driver (so the scalar code) gives it. The bench's mix, 1M vertices, against one
  * pass: AVX2 K = 4 1.3-1.4x as fast past 32-bit codes, AVX-512 K = 4 1.2-1.3x at 52 and 64 bits
  * (docs/benchmarks.md, session 10); K = 3 in wide lanes AVX2 ~1.2x, AVX-512 ~1.1x (session 11).
- * The first pass runs through its chunk several times as fast as the walk, too fast for lines
- * read for ownership: where the weights do not stream (codec_oss_batch.c), each of its stores
- * waited on one, and K = 3's wide lanes, whose one-pass decode hides that, ran 0.8x as fast in
- * two passes (session 10, before they streamed). Encode gains nothing from the same split
- * (tried: a K = 4 vertex of two weights still takes the load, division and floors that most of
- * its time goes to; AVX2 0.9x as fast).
+ * The first pass runs through its chunk several times as fast as the walk, so at that size its
+ * stores need the streaming ones (codec_oss_batch.c): with normal stores each waited on its
+ * line's read for ownership, which a one-pass decode hides under its arithmetic, and K = 3's
+ * wide lanes ran 0.8x as fast in two passes (session 10, before they streamed). Encode gains
+ * nothing from the same split (tried: a K = 4 vertex of two weights still takes the load,
+ * division and floors that most of its time goes to; AVX2 0.9x as fast; nor from one for the
+ * vertices of one weight, session 11: its first pass is bound by memory).
  */
 
 #define EDGE_CHUNK 256
@@ -936,9 +937,9 @@ typedef struct edge_list {
     int zeroed;          /* whether the buffers' rows are zero past their first two weights yet */
 } edge_list;
 
-/* Whether edge codes are decoded apart: K = 3 and 4 past the narrow lanes. In those the other
- * codes' decode is too cheap to pay for the two passes (the bench's mix, 1M vertices: K = 4 0.9x
- * as fast on AVX-512); every K = 2 code is an edge code. */
+/* Whether edge codes are decoded apart: K = 3 and 4 past the narrow lanes. In the narrow lanes
+ * the other codes' decode is too cheap to pay for the two passes (the bench's mix, 1M vertices:
+ * K = 4 0.9x as fast on AVX-512); every K = 2 code is an edge code. */
 SP_INLINE int edge_decode(const sp_codec* codec, uint32_t k)
 {
     return k >= 3 && !narrow_decode(codec, k);

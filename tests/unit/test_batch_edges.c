@@ -5,8 +5,8 @@
  * chunks that take the two passes counted (EDGE_TWO_PASSES), so a path that silently stopped
  * taking them fails here, not only one that decodes wrongly. For every kind of K = 4 lanes past
  * the narrow ones (split, double, wide with whole codes, wide up to 64-bit codes) and of K = 3
- * (double, wide, wide up to 64-bit codes): the bench's share of edge codes (3 in 4, the edges N - 1 and N among them) in
- * full chunks and a tail, with normal and with streaming stores, bit-identical to
+ * (double, wide, wide up to 64-bit codes): the bench's share of edge codes (3 in 4, the edges
+ * N - 1 and N among them) in full chunks and a tail, with normal and with streaming stores, bit-identical to
  * sp_decode_weights and nothing written past the batch, also through the library's dispatch at
  * every 4-byte offset from a line; an invalid code in a chunk's list or at its first vertex,
  * where the walk must stop before it with every vertex up to there decoded; few edge codes and
