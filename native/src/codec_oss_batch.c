@@ -9,32 +9,8 @@
 #include "codec_internal.h"
 #include "codec_oss_wide.h"
 
-/* Largest N per K for which the double lanes are exact (codec_oss_simd.h): every value with a
- * fractional quarter or half (row and layer numerators, the row root's argument) below 2^51,
- * every integer (the layer root's argument 8(N+1)^3 + ...) below 2^53, codes below 2^52 (AVX2's
- * conversion), and the layer numerator 9 u(k) + 12 below 2^50.3 for its floor by multiplication.
- * K = 3: rows s_N(j) < N^2/3 + N, apex^2 = (2N + 1)^2 < 2^50 at N = 2^24.
- * K = 4: 8(N + 1)^3 < 2^52.8 and 9 u(k) < 2^48.8 at N = 3 * 2^15 (codes of up to 45 bits). */
-#define BATCH_MAX_N2 ((uint64_t)1 << 48)
-#define BATCH_MAX_N3 ((uint64_t)1 << 24)
-#define BATCH_MAX_N4 ((uint64_t)3 << 15)
-
-/* Which lanes a codec takes: none, the double lanes, or the wide ones (past the double lanes'
- * N, every N of a 64-bit code: K = 3 grid coordinates below 2^35, K = 4 layers below 2^23, whose
- * in-layer indices stay below 2^47 in double). */
-typedef enum { LANES_NONE, LANES_DOUBLE, LANES_WIDE } oss_lanes;
-
-static oss_lanes oss_lanes_for(const sp_codec* codec)
-{
-    uint32_t k = codec->influences;
-    if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return LANES_NONE;
-    uint64_t limit = k == 2 ? BATCH_MAX_N2 : (k == 3 ? BATCH_MAX_N3 : BATCH_MAX_N4);
-    /* the same lanes both ways (K = 2 encode past 2^49: the exact pair rounding) */
-    return codec->n <= limit ? LANES_DOUBLE : LANES_WIDE;
-}
-
 /* The widest path this CPU, the caller and the codec allow. */
-static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
+static sp_isa batch_isa(sp_oss_lanes lanes, sp_isa widest)
 {
     if (lanes == LANES_NONE) return SP_ISA_SCALAR;
     sp_isa cpu = sp_cpu_isa();
@@ -44,7 +20,7 @@ static sp_isa batch_isa(oss_lanes lanes, sp_isa widest)
 /* Each ISA takes both ways, K = 2 encode past 2^50 grids too (codec_oss_wide_simd.h). */
 int sp_oss_batch_supported(const sp_codec* codec, sp_isa widest)
 {
-    return batch_isa(oss_lanes_for(codec), widest) > SP_ISA_SCALAR;
+    return batch_isa(sp_oss_lanes_for(codec), widest) > SP_ISA_SCALAR;
 }
 
 /* AVX-512 takes blocks of 8, AVX2 what is left in blocks of 4 (the tail, or the rest after a
@@ -55,7 +31,7 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 {
     size_t done = 0;
 #if SP_X86_SIMD
-    oss_lanes lanes = oss_lanes_for(codec);
+    sp_oss_lanes lanes = sp_oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
     sp_oss_encode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
     sp_oss_encode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
@@ -94,7 +70,7 @@ size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* code
     size_t done = 0;
     if (streamed) *streamed = 0;
 #if SP_X86_SIMD
-    oss_lanes lanes = oss_lanes_for(codec);
+    sp_oss_lanes lanes = sp_oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
     uint32_t k = codec->influences;
     if (isa < SP_ISA_AVX2 || !count) return 0; /* no pointer arithmetic on an empty batch's null arrays */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../../native/src/codec_internal.h" /* the *_isa batch forms: one path at a time */
+#include "../../native/src/codec_oss_wide.h"     /* the double lanes' limits */
 #include "check.h"
 #include "skinpack.h"
 
@@ -97,7 +98,7 @@ static int compare_encode_decoded(const sp_codec* c, const uint64_t* codes, size
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, (uint64_t)1 << 48}, {3, (uint64_t)1 << 24}, {4, (uint64_t)3 << 15}, {3, 8192}, {4, 1024}, {4, 80264}};
+        {2, BATCH_MAX_N2}, {3, BATCH_MAX_N3}, {4, BATCH_MAX_N4}, {3, 8192}, {4, 1024}, {4, 80264}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));

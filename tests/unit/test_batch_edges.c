@@ -74,7 +74,7 @@ static size_t decode_counted(const sp_codec* c, const uint64_t* codes, size_t co
     float* w = (float*)buffer;
     float ref[SP_MAX_INFLUENCES];
     two_pass_chunks = 0;
-    int wide = c->n > (c->influences == 4 ? 3 * ((uint64_t)1 << 15) : (uint64_t)1 << 24); /* codec_oss_batch.c's BATCH_MAX_N4, _N3 */
+    int wide = sp_oss_lanes_for(c) == LANES_WIDE;
     *done = wide ? counted_wide_decode(c, codes, count, w, stream) : counted_decode(c, codes, count, w, stream);
     for (size_t v = 0, failures = 0; v < *done && failures < 5; ++v) {
         sp_decode_weights(c, codes[v], ref);
@@ -179,7 +179,7 @@ int main(void)
     /* K = 4: split lanes (two), double lanes, wide with whole codes, wide up to 64-bit codes; K = 3: double lanes
      * (two), wide lanes, wide up to 64-bit codes */
     sp_codec codecs[] = {oss(4, 1025), oss(4, 60000), oss(4, 90000), oss(4, (uint64_t)1 << 17), widest, oss(3, 9000),
-                         oss(3, (uint64_t)1 << 24), oss(3, (uint64_t)1 << 26), widest3};
+                         oss(3, BATCH_MAX_N3), oss(3, (uint64_t)1 << 26), widest3};
     for (size_t i = 0; i < sizeof codecs / sizeof codecs[0]; ++i) {
         mixed(&codecs[i], 0);
         mixed(&codecs[i], 1);

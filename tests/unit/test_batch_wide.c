@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "../../native/src/codec_internal.h" /* the *_isa batch forms: one path at a time */
+#include "../../native/src/codec_oss_wide.h"     /* the double lanes' limits */
 #include "check.h"
 #include "skinpack.h"
 
@@ -79,7 +80,7 @@ static void boundaries(const sp_codec* c)
 /* K = 3 just past the double lanes (N = 2^24 + 1): codes around every row start, in batches. */
 static void every_row_start(void)
 {
-    sp_codec c = oss(3, ((uint64_t)1 << 24) + 1);
+    sp_codec c = oss(3, BATCH_MAX_N3 + 1);
     uint64_t rows = (2 * c.n + 1) / 3, batch = 1 << 18;
     uint64_t* codes = malloc(batch * 4 * sizeof(uint64_t));
     for (uint64_t first = 0; first <= rows; first += batch) {
@@ -264,11 +265,11 @@ int main(void)
         for (uint32_t k = 3; k <= 4; ++k)
             for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
                 sp_codec c = oss_bits(k, widths[i]);
-                if (c.n > (k == 3 ? (uint64_t)1 << 24 : (uint64_t)3 << 15)) check_codec(&c);
+                if (sp_oss_lanes_for(&c) == LANES_WIDE) check_codec(&c);
             }
         /* just past the double lanes, and the largest N of each K */
-        sp_codec edges[] = {oss(3, ((uint64_t)1 << 24) + 1), oss(4, ((uint64_t)3 << 15) + 1),
-                            oss(2, ((uint64_t)1 << 48) + 1), oss(2, (uint64_t)1 << 49)};
+        sp_codec edges[] = {oss(3, BATCH_MAX_N3 + 1), oss(4, BATCH_MAX_N4 + 1), oss(2, BATCH_MAX_N2 + 1),
+                            oss(2, (uint64_t)1 << 49)};
         for (size_t e = 0; e < sizeof(edges) / sizeof(edges[0]); ++e) check_codec(&edges[e]);
         /* K = 2 past 2^49: the exact pair rounding in the lanes */
         sp_codec k2_52 = oss_bits(2, 52), k2_64 = oss_bits(2, 64), k2_past = oss(2, ((uint64_t)1 << 49) + 1);

@@ -181,13 +181,11 @@ static void encode_counted(const sp_codec* c, int wide)
 static void check_encode(void)
 {
     static const uint32_t widths[] = {16, 22, 32, 44, 52, 64};
-    /* codec_oss_batch.c's double lanes' largest N per K */
-    static const uint64_t double_max[] = {0, 0, (uint64_t)1 << 48, (uint64_t)1 << 24, (uint64_t)3 << 15};
     for (uint32_t k = 2; k <= 4; ++k)
         for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
             sp_codec c;
             if (sp_codec_from_bits(SP_METHOD_OSS, k, widths[i] - (k == 2 && widths[i] == 64), &c) != SP_OK) continue;
-            encode_counted(&c, c.n > double_max[k]);
+            encode_counted(&c, sp_oss_lanes_for(&c) == LANES_WIDE);
         }
 }
 
@@ -219,7 +217,7 @@ int main(void)
             check_codec(&c);
         }
     /* just past the double lanes */
-    sp_codec k3 = oss(3, ((uint64_t)1 << 24) + 1), k4 = oss(4, ((uint64_t)3 << 15) + 1);
+    sp_codec k3 = oss(3, BATCH_MAX_N3 + 1), k4 = oss(4, BATCH_MAX_N4 + 1);
     check_codec(&k3);
     check_codec(&k4);
     return check_report(LANES_TEST);
