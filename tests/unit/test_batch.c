@@ -230,6 +230,32 @@ static void odd_weights(void)
     free(w);
 }
 
+/* Sorted tuples scaled down by 2^-e, e from 0 to 149 (the scale s / sum up to ~2^150), and
+ * sorted tuples with subnormal trailing weights under a normal first one: exact in whichever
+ * lanes take them. */
+static void tiny_weights(void)
+{
+    size_t count = 150 * 8 * 4;
+    float* w = malloc(count * 4 * sizeof(float));
+    for (uint32_t k = 2; k <= 4; ++k) {
+        static const uint32_t budgets[] = {16, 44, 64};
+        for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+            sp_codec c;
+            CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, budgets[b] - (k == 2 && budgets[b] == 64), &c) == SP_OK);
+            for (size_t v = 0; v < count; ++v) {
+                float* x = w + v * k;
+                random_tuple(k, c.scale, x);
+                if (v % 4 == 3) /* subnormal trailing weights under a normal first one */
+                    for (uint32_t i = 1; i < k; ++i) x[i] = ldexpf(x[i], -126 - (int)(rng_next() % 24));
+                else
+                    for (uint32_t i = 0; i < k; ++i) x[i] = ldexpf(x[i], -(int)(v / 32 % 150));
+            }
+            if (compare_encode(&c, w, count, "tiny weights encode")) break;
+        }
+    }
+    free(w);
+}
+
 /* One lane of a batch of sorted tuples made unsorted (each neighbouring pair swapped, a negative
  * or NaN weight at each place) or kept sorted by a zero or -0 last weight, in each lane of the
  * first three AVX-512 / six AVX2 blocks: each lane's order check alone (for K = 4 on AVX2 in float
@@ -369,6 +395,7 @@ int main(void)
         counts_and_alignment();
         invalid_codes();
         odd_weights();
+        tiny_weights();
         unsorted_lanes();
         range_edges();
         estimate_boundaries();
