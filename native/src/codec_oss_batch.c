@@ -12,7 +12,7 @@
 /* The widest path this CPU, the caller and the codec allow. */
 static sp_isa batch_isa(sp_oss_lanes lanes, sp_isa widest)
 {
-    if (lanes == LANES_NONE) return SP_ISA_SCALAR;
+    if (lanes == SP_LANES_NONE) return SP_ISA_SCALAR;
     sp_isa cpu = sp_cpu_isa();
     return cpu < widest ? cpu : widest;
 }
@@ -33,8 +33,8 @@ size_t sp_oss_encode_batch(const sp_codec* codec, const float* weights, size_t c
 #if SP_X86_SIMD
     sp_oss_lanes lanes = sp_oss_lanes_for(codec);
     sp_isa isa = batch_isa(lanes, widest);
-    sp_oss_encode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
-    sp_oss_encode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
+    sp_oss_encode_path* avx512 = lanes == SP_LANES_WIDE ? sp_oss_wide_encode_avx512 : sp_oss_encode_avx512;
+    sp_oss_encode_path* avx2 = lanes == SP_LANES_WIDE ? sp_oss_wide_encode_avx2 : sp_oss_encode_avx2;
     if (isa >= SP_ISA_AVX512) done = avx512(codec, weights, count, codes, significant);
     if (isa >= SP_ISA_AVX2 && done < count)
         done += avx2(codec, weights + done * codec->influences, count - done, codes + done,
@@ -74,8 +74,8 @@ size_t sp_oss_decode_batch_streaming(const sp_codec* codec, const uint64_t* code
     sp_isa isa = batch_isa(lanes, widest);
     uint32_t k = codec->influences;
     if (isa < SP_ISA_AVX2 || !count) return 0; /* no pointer arithmetic on an empty batch's null arrays */
-    sp_oss_decode_path* avx512 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
-    sp_oss_decode_path* avx2 = lanes == LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
+    sp_oss_decode_path* avx512 = lanes == SP_LANES_WIDE ? sp_oss_wide_decode_avx512 : sp_oss_decode_avx512;
+    sp_oss_decode_path* avx2 = lanes == SP_LANES_WIDE ? sp_oss_wide_decode_avx2 : sp_oss_decode_avx2;
     int large = count * k * sizeof(float) >= stream_min_bytes;
     size_t head = large ? stream_head(weights, k, count) : count;
     int stream = head < count;

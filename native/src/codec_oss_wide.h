@@ -25,14 +25,14 @@
  * in-layer indices stay below 2^47 in double). The same lanes both ways (K = 2 encode past 2^49:
  * the exact pair rounding). codec_oss_batch.c dispatches by it; the tests that compile a driver
  * themselves pick theirs by it. */
-typedef enum { LANES_NONE, LANES_DOUBLE, LANES_WIDE } sp_oss_lanes;
+typedef enum { SP_LANES_NONE, SP_LANES_DOUBLE, SP_LANES_WIDE } sp_oss_lanes;
 
 SP_INLINE sp_oss_lanes sp_oss_lanes_for(const sp_codec* codec)
 {
     uint32_t k = codec->influences;
-    if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return LANES_NONE;
+    if (codec->method != SP_METHOD_OSS || k < 2 || k > 4 || codec->n < 2) return SP_LANES_NONE;
     uint64_t limit = k == 2 ? BATCH_MAX_N2 : (k == 3 ? BATCH_MAX_N3 : BATCH_MAX_N4);
-    return codec->n <= limit ? LANES_DOUBLE : LANES_WIDE;
+    return codec->n <= limit ? SP_LANES_DOUBLE : SP_LANES_WIDE;
 }
 
 /* Encode `count` vertices of k weights (significant may be NULL) or decode `count` codes, whole

@@ -74,7 +74,7 @@ static size_t decode_counted(const sp_codec* c, const uint64_t* codes, size_t co
     float* w = (float*)buffer;
     float ref[SP_MAX_INFLUENCES];
     two_pass_chunks = 0;
-    int wide = sp_oss_lanes_for(c) == LANES_WIDE;
+    int wide = sp_oss_lanes_for(c) == SP_LANES_WIDE;
     *done = wide ? counted_wide_decode(c, codes, count, w, stream) : counted_decode(c, codes, count, w, stream);
     for (size_t v = 0, failures = 0; v < *done && failures < 5; ++v) {
         sp_decode_weights(c, codes[v], ref);

@@ -265,7 +265,7 @@ int main(void)
         for (uint32_t k = 3; k <= 4; ++k)
             for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
                 sp_codec c = oss_bits(k, widths[i]);
-                if (sp_oss_lanes_for(&c) == LANES_WIDE) check_codec(&c);
+                if (sp_oss_lanes_for(&c) == SP_LANES_WIDE) check_codec(&c);
             }
         /* just past the double lanes, and the largest N of each K */
         sp_codec edges[] = {oss(3, BATCH_MAX_N3 + 1), oss(4, BATCH_MAX_N4 + 1), oss(2, BATCH_MAX_N2 + 1),

@@ -185,7 +185,7 @@ static void check_encode(void)
         for (size_t i = 0; i < sizeof(widths) / sizeof(widths[0]); ++i) {
             sp_codec c;
             if (sp_codec_from_bits(SP_METHOD_OSS, k, widths[i] - (k == 2 && widths[i] == 64), &c) != SP_OK) continue;
-            encode_counted(&c, sp_oss_lanes_for(&c) == LANES_WIDE);
+            encode_counted(&c, sp_oss_lanes_for(&c) == SP_LANES_WIDE);
         }
 }
 
