@@ -618,11 +618,9 @@ DEFINE_DECODE_WALK(decode_walk, decode_chunk, BLOCK, DECODE_CHUNK, 1)
  * and layer estimates run in float, as estimates only: an estimate that misses (more often than
  * in double: ~3e-4 of random K = 3 codes at 24 bits) fails the same exact row check and is
  * redone by the scalar code. The weights are the correctly rounded q/s (store_weights32), which
- * the double product of the scalar code is too for these q and s.
+ * the double product of the scalar code is too for these q and s. (The limits are in
+ * codec_oss_wide.h, with the double lanes', for the tests to use.)
  */
-#define NARROW_MAX_N3 8192 /* apex^2 and 12 w < 2^28.1; codes < 2^24.5 */
-#define NARROW_MAX_N4 1024 /* 9 u((N + 1) / 2) < 2^29.1, 8 (N + 1)^3 < 2^33.1 (float); codes < 2^26 */
-
 SP_INLINE int narrow_decode(const sp_codec* codec, uint32_t k)
 {
     return (k == 3 && codec->n <= NARROW_MAX_N3) || (k == 4 && codec->n <= NARROW_MAX_N4);
@@ -774,8 +772,6 @@ DEFINE_DECODE_WALK(decode_walk_narrow, decode_chunk_narrow, NBLOCK, NARROW_CHUNK
  * s_B(j) = j (B - j) + floor((j + 1) / 2) ceil((j + 1) / 2) <= S(N) is a sum of two products
  * below 2^31.
  */
-#define SPLIT_MAX_N4 80264 /* the largest N with (N^2 + N + 1) / 3 <= 2^31 - 1 */
-
 SP_INLINE int split_decode(const sp_codec* codec, uint32_t k)
 {
     return k == 4 && codec->n > NARROW_MAX_N4 && codec->n <= SPLIT_MAX_N4;

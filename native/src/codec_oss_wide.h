@@ -3,7 +3,8 @@
  * N = 2^24, K = 4 past N = 3 * 2^15, K = 2 past N = 2^48 (every width up to 64 bits; K = 2 encode
  * past N = 2^49 in sp_grid_round_pair's exact rounding, with FMA residuals). The driver is
  * codec_oss_wide_simd.h, the per-ISA files codec_oss_batch_avx2.c and codec_oss_batch_avx512.c;
- * codec_oss_batch.c dispatches.
+ * codec_oss_batch.c dispatches. Also the limits of every lane kind, which the drivers, the
+ * dispatch and the tests share.
  */
 #ifndef SKINPACK_CODEC_OSS_WIDE_H
 #define SKINPACK_CODEC_OSS_WIDE_H
@@ -19,6 +20,13 @@
 #define BATCH_MAX_N2 ((uint64_t)1 << 48)
 #define BATCH_MAX_N3 ((uint64_t)1 << 24)
 #define BATCH_MAX_N4 ((uint64_t)3 << 15)
+
+/* Within the double lanes, the decode ranges that run in 32-bit lanes (codec_oss_simd.h): the
+ * narrow codes, whose every exact intermediate is an int32, and K = 4 with the in-layer index in
+ * int32 (the split). */
+#define NARROW_MAX_N3 8192  /* apex^2 and 12 w < 2^28.1; codes < 2^24.5 */
+#define NARROW_MAX_N4 1024  /* 9 u((N + 1) / 2) < 2^29.1, 8 (N + 1)^3 < 2^33.1 (float); codes < 2^26 */
+#define SPLIT_MAX_N4 80264  /* the largest N with (N^2 + N + 1) / 3 <= 2^31 - 1 */
 
 /* Which lanes a codec takes: none, the double lanes, or the wide ones (past the double lanes'
  * N, every N of a 64-bit code: K = 3 grid coordinates below 2^35, K = 4 layers below 2^23, whose

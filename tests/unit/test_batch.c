@@ -91,14 +91,15 @@ static int compare_encode_decoded(const sp_codec* c, const uint64_t* codes, size
 }
 
 /* N at and just past the largest the vector paths accept (exact there, scalar beyond), and the
- * largest their 32-bit lanes decode (K = 3: 8192, K = 4: 1024, and K = 4 with the rows in
- * 32-bit lanes: 80264; double lanes beyond), and
+ * largest their 32-bit lanes decode (K = 3: NARROW_MAX_N3, K = 4: NARROW_MAX_N4, and K = 4 with
+ * the rows in 32-bit lanes: SPLIT_MAX_N4; double lanes beyond), and
  * codes at every layer and row start/end there, where the root estimates are off by one, and
  * the last codes, where the layer estimate's cube root argument is smallest. */
 static void range_edges(void)
 {
     static const struct { uint32_t k; uint64_t n; } edges[] = {
-        {2, BATCH_MAX_N2}, {3, BATCH_MAX_N3}, {4, BATCH_MAX_N4}, {3, 8192}, {4, 1024}, {4, 80264}};
+        {2, BATCH_MAX_N2}, {3, BATCH_MAX_N3}, {4, BATCH_MAX_N4}, {3, NARROW_MAX_N3}, {4, NARROW_MAX_N4},
+        {4, SPLIT_MAX_N4}};
     size_t count = 200000;
     float* w = malloc(count * 4 * sizeof(float));
     uint64_t* codes = malloc(count * sizeof(uint64_t));
@@ -153,13 +154,14 @@ static void estimate_boundaries(void)
     }
 }
 
-/* K = 4 with the rows in 32-bit lanes (N = 1025 .. 80264): every row's first and last codes
+/* K = 4 with the rows in 32-bit lanes (N past NARROW_MAX_N4 up to SPLIT_MAX_N4): every row's
+ * first and last codes
  * (and their neighbours) in the first layers, one in the middle and the last ones, where the
  * float row estimate, taken half a row low, is closest to two rows off, and the int32 row
  * bases and offsets are largest (layer 0 of N = 80264: S = 2^31 - 1.8e5). */
 static void split_row_boundaries(void)
 {
-    static const uint64_t ns[] = {1025, 4258, 17038, 68158, 80264};
+    static const uint64_t ns[] = {NARROW_MAX_N4 + 1, 4258, 17038, 68158, SPLIT_MAX_N4};
     for (size_t e = 0; e < sizeof(ns) / sizeof(ns[0]); ++e) {
         uint64_t n = ns[e], last_layer = (n + 1) / 2 - 1;
         const uint64_t layers[] = {0, 1, 2, last_layer / 2, last_layer - 2, last_layer - 1, last_layer};
@@ -184,23 +186,25 @@ static void split_row_boundaries(void)
 }
 
 /* Every weight q / s the 32-bit lanes compute (every q <= s = 2(N - 1) of every N they take,
- * K = 3 up to 8192, K = 4 up to 1024; with the rows in 32-bit lanes, K = 4 up to 80264, every q
+ * K = 3 up to NARROW_MAX_N3, K = 4 up to NARROW_MAX_N4; with the rows in 32-bit lanes, K = 4 up
+ * to SPLIT_MAX_N4, every q
  * of the first N past the narrow lanes, of the bench's 32/38/44-bit N, of the largest and of
  * 200 random N between): the first row of the first layer, codes 0..N - 1, holds q1 = 0..N - 1
  * and q0 = N - 1..s, so it reaches every q. */
 static void narrow_weights(void)
 {
-    enum { SPLIT_LARGEST = 80264 };
-    uint64_t* codes = malloc(SPLIT_LARGEST * sizeof(uint64_t));
-    for (uint64_t v = 0; v < SPLIT_LARGEST; ++v) codes[v] = v;
+    uint64_t* codes = malloc(SPLIT_MAX_N4 * sizeof(uint64_t));
+    for (uint64_t v = 0; v < SPLIT_MAX_N4; ++v) codes[v] = v;
     for (uint32_t k = 3; k <= 4; ++k)
-        for (uint64_t n = 2; n <= (k == 3 ? 8192u : 1024u); ++n) {
+        for (uint64_t n = 2; n <= (k == 3 ? NARROW_MAX_N3 : NARROW_MAX_N4); ++n) {
             sp_codec c = oss(k, n);
             if (compare_decode(&c, codes, (size_t)n, "narrow weights")) break;
         }
-    static const uint64_t split[] = {1025, 1026, 4258, 17038, 68158, SPLIT_LARGEST - 1, SPLIT_LARGEST};
-    for (size_t i = 0; i < sizeof(split) / sizeof(split[0]) + 200; ++i) {
-        uint64_t n = i < sizeof(split) / sizeof(split[0]) ? split[i] : 1025 + rng_next() % (SPLIT_LARGEST - 1024);
+    static const uint64_t split[] = {NARROW_MAX_N4 + 1, NARROW_MAX_N4 + 2, 4258, 17038, 68158, SPLIT_MAX_N4 - 1,
+                                     SPLIT_MAX_N4};
+    size_t listed = sizeof(split) / sizeof(split[0]);
+    for (size_t i = 0; i < listed + 200; ++i) {
+        uint64_t n = i < listed ? split[i] : NARROW_MAX_N4 + 1 + rng_next() % (SPLIT_MAX_N4 - NARROW_MAX_N4);
         sp_codec c = oss(4, n);
         if (compare_decode(&c, codes, (size_t)n, "split weights")) break;
     }

@@ -178,8 +178,8 @@ int main(void)
     CHECK(sp_codec_from_bits(SP_METHOD_OSS, 3, 64, &widest3) == SP_OK);
     /* K = 4: split lanes (two), double lanes, wide with whole codes, wide up to 64-bit codes; K = 3: double lanes
      * (two), wide lanes, wide up to 64-bit codes */
-    sp_codec codecs[] = {oss(4, 1025), oss(4, 60000), oss(4, 90000), oss(4, (uint64_t)1 << 17), widest, oss(3, 9000),
-                         oss(3, BATCH_MAX_N3), oss(3, (uint64_t)1 << 26), widest3};
+    sp_codec codecs[] = {oss(4, NARROW_MAX_N4 + 1), oss(4, 60000), oss(4, 90000), oss(4, (uint64_t)1 << 17), widest,
+                         oss(3, 9000), oss(3, BATCH_MAX_N3), oss(3, (uint64_t)1 << 26), widest3};
     for (size_t i = 0; i < sizeof codecs / sizeof codecs[0]; ++i) {
         mixed(&codecs[i], 0);
         mixed(&codecs[i], 1);
