@@ -155,10 +155,10 @@ static void estimate_boundaries(void)
 }
 
 /* K = 4 with the rows in 32-bit lanes (N past NARROW_MAX_N4 up to SPLIT_MAX_N4): every row's
- * first and last codes
- * (and their neighbours) in the first layers, one in the middle and the last ones, where the
- * float row estimate, taken half a row low, is closest to two rows off, and the int32 row
- * bases and offsets are largest (layer 0 of N = 80264: S = 2^31 - 1.8e5). */
+ * first and last codes (and their neighbours) in the first layers, one in the middle and the
+ * last ones, where the float row estimate, taken half a row low, is closest to two rows off,
+ * and the int32 row bases and offsets are largest (layer 0 of N = SPLIT_MAX_N4 = 80264:
+ * S = 2^31 - 1.8e5). */
 static void split_row_boundaries(void)
 {
     static const uint64_t ns[] = {NARROW_MAX_N4 + 1, 4258, 17038, 68158, SPLIT_MAX_N4};
@@ -187,10 +187,9 @@ static void split_row_boundaries(void)
 
 /* Every weight q / s the 32-bit lanes compute (every q <= s = 2(N - 1) of every N they take,
  * K = 3 up to NARROW_MAX_N3, K = 4 up to NARROW_MAX_N4; with the rows in 32-bit lanes, K = 4 up
- * to SPLIT_MAX_N4, every q
- * of the first N past the narrow lanes, of the bench's 32/38/44-bit N, of the largest and of
- * 200 random N between): the first row of the first layer, codes 0..N - 1, holds q1 = 0..N - 1
- * and q0 = N - 1..s, so it reaches every q. */
+ * to SPLIT_MAX_N4, every q of the first N past the narrow lanes, of the bench's 32/38/44-bit N,
+ * of the largest and of 200 random N between): the first row of the first layer, codes
+ * 0..N - 1, holds q1 = 0..N - 1 and q0 = N - 1..s, so it reaches every q. */
 static void narrow_weights(void)
 {
     uint64_t* codes = malloc(SPLIT_MAX_N4 * sizeof(uint64_t));
