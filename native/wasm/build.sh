@@ -35,8 +35,9 @@ flags=""
 for name in $exports; do flags="$flags -Wl,--export=$name"; done
 
 mkdir -p "$(dirname "$out")"
+# -ffp-contract=off as in native/CMakeLists.txt: each operation rounds as the specification's.
 # shellcheck disable=SC2086 # $flags and the sysroot option are word lists
-"$cc" --target=wasm32-wasi ${sysroot:+--sysroot="$sysroot"} -std=c11 -O2 -flto -Wall -Wextra -Werror \
+"$cc" --target=wasm32-wasi ${sysroot:+--sysroot="$sysroot"} -std=c11 -O2 -flto -ffp-contract=off -Wall -Wextra -Werror \
   -fvisibility=hidden -I"$here/../include" -nostartfiles -Wl,--no-entry -Wl,--gc-sections $flags \
   -o "$out.tmp" "$here/skinpack_wasm.c" "$@"
 mv "$out.tmp" "$out"

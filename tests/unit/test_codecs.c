@@ -42,6 +42,32 @@ static void exhaustive_identity(void)
             }
 }
 
+/* Any's axes round independently, so w1 = 1 - w2 - ... - wK can come out below 0; the encoder
+ * then steps an axis down, and must judge w1 exactly as the decoder computes it (the
+ * specification: each operation rounded), or it writes codes the decoder rejects. The hard
+ * inputs are the axis weights of every code with w1 clamped to 0, where w1 is 0 or just below
+ * (e.g. 0, 1/2, 1/3, 1/6 on axes 22, 23, 25). Fails where the library is built with FMA
+ * contraction (GCC on AArch64 fused the encoder's check of w1 and not the decoder's). */
+static void any_codes_decode(void)
+{
+    for (uint32_t k = 3; k <= 4; ++k)
+        for (uint64_t q = 2; q <= 32; ++q) {
+            uint64_t axes[3] = {q, q + 1, q + 3};
+            sp_codec c;
+            CHECK(sp_codec_from_params(SP_METHOD_ANY, k, 0, axes, &c) == SP_OK);
+            for (uint64_t code = 0; code <= c.max_code; ++code) {
+                float w[4], decoded[4];
+                size_t bad = 0;
+                sp_decode_weights(&c, code, w);
+                w[0] = w[0] > 0 ? w[0] : 0;
+                uint64_t again = sp_encode_weights(&c, w);
+                CHECK_MSG(sp_decode_weights_batch(&c, &again, 1, decoded, &bad) == SP_OK,
+                          "any K=%u axes %llu: code %llu -> %llu, rejected", k, (unsigned long long)q,
+                          (unsigned long long)code, (unsigned long long)again);
+            }
+        }
+}
+
 /* Random convex weights, sorted; some with zeros, some nearly equal (the hard corners). */
 static void random_weights(uint32_t k, float* w)
 {
@@ -179,6 +205,7 @@ static void configuration_errors(void)
 int main(void)
 {
     exhaustive_identity();
+    any_codes_decode();
     bound_holds_on_random_input();
     fixed_point_is_exact();
     configuration_errors();
