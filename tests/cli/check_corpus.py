@@ -83,7 +83,9 @@ def resolved(document_path, uri):
     from urllib.parse import unquote
     if ":" in uri.split("/")[0]:
         return ("uri", uri)
-    return ("file", os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(document_path)), unquote(uri))))
+    # realpath: the CLI rebases uris between canonical folders, so an input reached through a
+    # symlink (../shared may be one) resolves to the same file by another spelling.
+    return ("file", os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(document_path)), unquote(uri))))
 
 
 def file_bytes(reference):
