@@ -178,16 +178,18 @@ SP_INLINE uint64_t oss_pack_small(const oss_pack_form* form, uint32_t k, const u
     return layer_base + row_base + (q[1] - q[2]);
 }
 
-/* One vertex of oss_encode_chunks: w and scale are its weights as doubles and its grid scale
- * (sp_grid_load), loaded a vertex before; loads the next vertex's (or its own again for the
- * last) into next and returns their scale. The grid s comes as a value (also as a double), not
- * read through codec, which the stores to codes might alias. */
+/* One vertex of oss_encode_listed: w and scale are its weights as doubles and its grid scale
+ * (sp_grid_load), loaded a vertex before; loads those of `next_vertex` (the next vertex to
+ * encode, or its own weights again for the last) into next and returns their scale. The grid s
+ * comes as a value (also as a double), not read through codec, which the stores to codes might
+ * alias. */
 SP_INLINE double oss_encode_vertex(const sp_codec* codec, const oss_pack_form* form, uint64_t s, double grid,
-                                   const float* weights, size_t v, size_t count, const double* w, double scale,
-                                   double* next, uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
+                                   const float* weights, size_t v, const float* next_vertex, const double* w,
+                                   double scale, double* next, uint64_t* codes, uint8_t* significant, uint32_t k,
+                                   int form_kind)
 {
     const float* vertex = weights + v * k;
-    double next_scale = sp_grid_load(v + 1 < count ? vertex + k : vertex, k, grid, next);
+    double next_scale = sp_grid_load(next_vertex, k, grid, next);
     uint64_t q[SP_MAX_INFLUENCES];
     if (!sp_grid_round(vertex, w, k, s, scale, q)) {
         codes[v] = sp_oss_encode_one(codec, vertex, significant ? significant + v : NULL);
@@ -199,28 +201,126 @@ SP_INLINE double oss_encode_vertex(const sp_codec* codec, const oss_pack_form* f
     return next_scale;
 }
 
+/*
+ * One-weight vertices, (w0, +0, ..., +0) with w0 finite and > 0: half of a rig's vertices (the
+ * paper's mix has 51 %), all with one code. The general rounding gives each q = (s, 0, ..., 0):
+ * the sum is w0, the scale s / w0 and x0 = w0 (s / w0) is s within two roundings, so it floors
+ * to s (deficit 0) or to s - 1 with the only remainder above +0 (deficit 1, given to slot 0);
+ * every other x is +0 * scale = +0. So a chunk of the scalar encoder first writes that code to
+ * every vertex and lists the others, which it then encodes, and a chunk of the decoder writes
+ * that code's weights and decodes the other codes: no per-vertex branch, which would mispredict
+ * where one- and many-weight vertices mix.
+ */
+#define ONE_WEIGHT_CHUNK 256
+
+/* The listing costs about a sixth of a many-weight vertex's encode, so it pays where more than
+ * ~1/5 of a chunk's vertices have one weight. After a chunk with fewer than 1/4 the next
+ * ONE_WEIGHT_SKIP chunks go unlisted (their one-weight vertices take the general path, with the
+ * same result): a mesh without one-weight vertices lists one chunk in ONE_WEIGHT_SKIP + 1 and
+ * runs ~3 % slower than without the shortcut, one of the paper's mix 1.5x (encode) to 1.7x
+ * (decode) faster (docs/benchmarks.md, session 14). */
+#define ONE_WEIGHT_SKIP 7
+
+SP_INLINE size_t oss_chunks_to_skip(size_t ones, size_t size)
+{
+    return ones * 4 < size ? ONE_WEIGHT_SKIP : 0;
+}
+
+/* Entry i of the list of a chunk's other vertices, or i where nothing was listed (others NULL,
+ * a constant once inlined: the loops then run over the chunk as they did before the shortcut). */
+SP_INLINE size_t oss_listed_at(const uint32_t* others, size_t i)
+{
+    return others ? others[i] : i;
+}
+
+/* 1 unless the vertex is a one-weight vertex (above): sp_grid_plain's test on w0 alone, and the
+ * other weights' bits 0, in one compare (those bits, if any, put the key at 2^32 or more). */
+SP_INLINE size_t oss_not_one_weight(const float* vertex, uint32_t k)
+{
+    uint32_t first, rest = 0;
+    memcpy(&first, &vertex[0], sizeof(first));
+    SP_UNROLL for (uint32_t i = 1; i < k; ++i) {
+        uint32_t bits;
+        memcpy(&bits, &vertex[i], sizeof(bits));
+        rest |= bits;
+    }
+    return ((uint64_t)rest << 32 | (uint32_t)(first - 1)) >= 0x7F7FFFFFu;
+}
+
+/* The code of a one-weight vertex and its count of significant weights. */
+static uint64_t oss_one_weight_code(const sp_codec* codec, uint8_t* significant)
+{
+    const float one[SP_MAX_INFLUENCES] = {1, 0, 0, 0};
+    return sp_oss_encode_one(codec, one, significant);
+}
+
+/* Vertices first..end-1: the one-weight code into every one, the others' indices (from first)
+ * into `others`; returns how many those are. */
+SP_INLINE size_t oss_list_others(const float* weights, size_t first, size_t end, uint32_t k, uint64_t one_code,
+                                 uint8_t one_significant, uint64_t* codes, uint8_t* significant, uint32_t* others)
+{
+    size_t listed = 0;
+    if (significant) memset(significant + first, one_significant, end - first);
+    for (size_t v = first; v < end; ++v) {
+        others[listed] = (uint32_t)(v - first);
+        listed += oss_not_one_weight(weights + v * k, k);
+        codes[v] = one_code;
+    }
+    return listed;
+}
+
+/* The vertices oss_listed_at(others, 0..listed-1) of a chunk (its weights, codes and counts at
+ * `weights`, `codes`, `significant`), software-pipelined: each vertex's weights are loaded and
+ * its grid scale divided one vertex ahead, so that the division (the end of a long chain)
+ * overlaps the previous vertex's rounding and index, and the weights are converted to double
+ * once; two vertices a turn, so that the two sets of loaded weights take turns in registers
+ * instead of being copied. */
+SP_INLINE void oss_encode_listed(const sp_codec* codec, const oss_pack_form* form, const float* weights,
+                                 const uint32_t* others, size_t listed, uint64_t* codes, uint8_t* significant,
+                                 uint32_t k, int form_kind)
+{
+    uint64_t s = codec->scale;
+    double grid = (double)s;
+    double even[SP_MAX_INFLUENCES], odd[SP_MAX_INFLUENCES];
+    double even_scale = sp_grid_load(weights + oss_listed_at(others, 0) * k, k, grid, even), odd_scale;
+    for (size_t i = 0; i < listed; i += 2) {
+        const float* next = weights + oss_listed_at(others, i + 1 < listed ? i + 1 : i) * k;
+        odd_scale = oss_encode_vertex(codec, form, s, grid, weights, oss_listed_at(others, i), next, even,
+                                      even_scale, odd, codes, significant, k, form_kind);
+        if (i + 1 == listed) break;
+        next = weights + oss_listed_at(others, i + 2 < listed ? i + 2 : i + 1) * k;
+        even_scale = oss_encode_vertex(codec, form, s, grid, weights, oss_listed_at(others, i + 1), next, odd,
+                                       odd_scale, even, codes, significant, k, form_kind);
+    }
+}
+
 /* The vertices first..count-1 with k constant, so the rounding and the index unroll into
  * straight-line code with q in registers: the index in the given OSS_FORM_*. Vertices the
- * double rounding does not settle take sp_oss_encode_one. Software-pipelined: each vertex's
- * weights are loaded and its grid scale divided one vertex ahead, so that the division (the end
- * of a long chain) overlaps the previous vertex's rounding and index, and the weights are
- * converted to double once; two vertices a turn, so that the two sets of loaded weights take
- * turns in registers instead of being copied. */
+ * double rounding does not settle take sp_oss_encode_one. Per chunk, the one-weight vertices
+ * take their code at once (above) and the others are encoded by oss_encode_listed. */
 SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, size_t first, size_t count,
                                  uint64_t* codes, uint8_t* significant, uint32_t k, int form_kind)
 {
     oss_pack_form form = pack_form(codec->n);
-    uint64_t s = codec->scale;
-    double grid = (double)s;
-    if (first >= count) return;
-    double even[SP_MAX_INFLUENCES], odd[SP_MAX_INFLUENCES];
-    double even_scale = sp_grid_load(weights + first * k, k, grid, even), odd_scale;
-    for (size_t v = first; v < count; v += 2) {
-        odd_scale = oss_encode_vertex(codec, &form, s, grid, weights, v, count, even, even_scale, odd, codes,
-                                      significant, k, form_kind);
-        if (v + 1 == count) break;
-        even_scale = oss_encode_vertex(codec, &form, s, grid, weights, v + 1, count, odd, odd_scale, even, codes,
-                                       significant, k, form_kind);
+    uint8_t one_significant;
+    uint64_t one_code = oss_one_weight_code(codec, &one_significant);
+    uint32_t others[ONE_WEIGHT_CHUNK];
+    size_t skipped = 0;
+    for (size_t start = first, end; start < count; start = end) {
+        size_t size = skipped ? skipped * ONE_WEIGHT_CHUNK : ONE_WEIGHT_CHUNK, listed;
+        end = count - start < size ? count : start + size;
+        if (skipped) {
+            listed = end - start, skipped = 0;
+        } else {
+            listed = oss_list_others(weights, start, end, k, one_code, one_significant, codes, significant, others);
+            skipped = oss_chunks_to_skip(end - start - listed, end - start);
+        }
+        const float* chunk = weights + start * k;
+        uint8_t* chunk_significant = significant ? significant + start : NULL;
+        if (listed == end - start)
+            oss_encode_listed(codec, &form, chunk, NULL, listed, codes + start, chunk_significant, k, form_kind);
+        else if (listed)
+            oss_encode_listed(codec, &form, chunk, others, listed, codes + start, chunk_significant, k, form_kind);
     }
 }
 
@@ -418,8 +518,52 @@ void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
 /* Codes per stage of the scalar decoder. A K = 3, 4 decode is one long dependency chain (a
  * cube root and a layer base, then a square root and a row base), longer than the core's
  * reorder window holds a few of, so the decoder runs in stages (layers, then rows) over a chunk:
- * the codes of a stage are independent, and the core overlaps more of them. */
-#define SCALAR_CHUNK 16
+ * the codes of a stage are independent, and the core overlaps more of them. The one-weight code
+ * (oss_one_weight_code) skips both: a listed chunk first writes its weights to every vertex and
+ * lists the other codes, which the stages then decode (a chunk twice as long as the stages take,
+ * since about half of a rig's codes are that one). */
+#define SCALAR_CHUNK 32
+
+/* The weights of the one-weight code, as the stages below would write them. */
+static void oss_one_weight_weights(const sp_codec* codec, uint64_t one_code, double inverse, float* one)
+{
+    uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    sp_oss_unpack(codec->n, codec->influences, one_code, q);
+    for (uint32_t i = 0; i < codec->influences; ++i) one[i] = (float)((double)q[i] * inverse);
+}
+
+/* The codes oss_listed_at(others, 0..listed-1) of a chunk (at `codes`, weights at `weights`),
+ * K = 3 or 4, all valid: the layer stage, then the row stage. */
+SP_INLINE void oss_decode_listed(uint64_t n, double inverse, const uint64_t* codes, const uint32_t* others,
+                                 size_t listed, float* weights, uint32_t k)
+{
+    uint64_t layer[SCALAR_CHUNK], rest[SCALAR_CHUNK];
+    for (size_t i = 0; i < listed; ++i) {
+        layer[i] = 0, rest[i] = codes[oss_listed_at(others, i)];
+        if (k == 4) layer[i] = unpack_layer(n, rest[i], &rest[i]);
+    }
+    for (size_t i = 0; i < listed; ++i) {
+        uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+        unpack_rows(n, k, layer[i], rest[i], q);
+        float* vertex = weights + oss_listed_at(others, i) * k;
+        SP_UNROLL
+        for (uint32_t j = 0; j < k; ++j) vertex[j] = (float)((double)q[j] * inverse);
+    }
+}
+
+/* Codes first..end-1 (all valid): the one-weight code's weights into every vertex, the other
+ * codes' indices (from first) into `others`; returns how many those are. */
+SP_INLINE size_t oss_list_other_codes(const uint64_t* codes, size_t first, size_t end, uint64_t one_code,
+                                      const float* one, float* weights, uint32_t k, uint32_t* others)
+{
+    size_t listed = 0;
+    for (size_t v = first; v < end; ++v) {
+        others[listed] = (uint32_t)(v - first);
+        listed += codes[v] != one_code;
+        memcpy(weights + v * k, one, k * sizeof(float));
+    }
+    return listed;
+}
 
 /* Decodes codes first..count-1 with k constant; stops at a code past the codec's range. */
 SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, size_t first, size_t count,
@@ -435,19 +579,21 @@ SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, si
         }
         return count;
     }
+    uint64_t one_code = oss_one_weight_code(codec, NULL);
+    float one[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
+    oss_one_weight_weights(codec, one_code, inverse, one);
+    uint32_t others[SCALAR_CHUNK];
+    size_t skipped = 0; /* chunks left to decode unlisted (oss_chunks_to_skip) */
     for (size_t v = first; v < count;) {
-        uint64_t layer[SCALAR_CHUNK], rest[SCALAR_CHUNK];
         size_t end = count - v < SCALAR_CHUNK ? count : v + SCALAR_CHUNK, valid = v;
         while (valid < end && codes[valid] <= max_code) ++valid;
-        for (size_t c = 0; c < valid - v; ++c) {
-            layer[c] = 0, rest[c] = codes[v + c];
-            if (k == 4) layer[c] = unpack_layer(n, rest[c], &rest[c]);
-        }
-        for (size_t c = 0; c < valid - v; ++c) {
-            uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-            unpack_rows(n, k, layer[c], rest[c], q);
-            SP_UNROLL
-            for (uint32_t i = 0; i < k; ++i) weights[(v + c) * k + i] = (float)((double)q[i] * inverse);
+        if (skipped) {
+            --skipped;
+            oss_decode_listed(n, inverse, codes + v, NULL, valid - v, weights + v * k, k);
+        } else {
+            size_t listed = oss_list_other_codes(codes, v, valid, one_code, one, weights, k, others);
+            skipped = oss_chunks_to_skip(valid - v - listed, valid - v);
+            oss_decode_listed(n, inverse, codes + v, others, listed, weights + v * k, k);
         }
         if (valid < end) return valid;
         v = end;

@@ -6,7 +6,10 @@
  *     and unsorted weights (layers past the tetrahedron, where the code wraps as sp_oss_pack's
  *     does); likewise the K = 3 row base past 2^30 (OSS_ROW64_N) modulo 2^64;
  *   - the rounding's skipped clamps: -0 in place of +0 must not change a code or a count (the
- *     remainders are ranked as bit patterns, where -0 would sort above every remainder).
+ *     remainders are ranked as bit patterns, where -0 would sort above every remainder);
+ *   - the one-weight code written without a rounding (and its weights without a decode): every
+ *     w0 > 0 of each exponent, denormals and the largest float, among vertices it must not
+ *     take: -0 or a denormal in another slot, w0 of 0, -0, < 0, inf or NaN, the weight in slot 1.
  * The reference is sp_grid_quantize and sp_oss_pack vertex by vertex; the batch runs the
  * scalar path only (SP_ISA_SCALAR).
  */
@@ -119,9 +122,66 @@ static void negative_zeros(void)
     free(w), free(negative), free(codes), free(negative_codes), free(counts), free(negative_counts);
 }
 
+/* w0 of vertex v: every exponent from denormal to the largest with a random significand, and
+ * every 11th one from a list of ones the shortcut must take (1, the extremes) or leave to the
+ * rounding (zeros, negative, inf, NaN). */
+static float one_weight_w0(size_t v)
+{
+    static const uint32_t listed[] = {0x00000000u, 0x80000000u, 0xBF800000u, 0x7F800000u, 0x7FC00000u,
+                                      0xFF800000u, 0x7F7FFFFFu, 0x00000001u, 0x3F800000u};
+    uint32_t bits = v % 11 == 0 ? listed[v / 11 % (sizeof(listed) / sizeof(listed[0]))]
+                                : (uint32_t)(v % 255) << 23 | (uint32_t)(rng_next() & 0x7FFFFFu);
+    float w0;
+    memcpy(&w0, &bits, sizeof(w0));
+    return w0;
+}
+
+/* Vertices (w0, +0, ...) among ones the shortcut must not take, encoded and decoded by the
+ * scalar path against the per-vertex reference, for each K and the bench widths; in the middle
+ * a run where one vertex in 9 has one weight, too few for the shortcut to list its chunks. */
+static void one_weight_vertices(void)
+{
+    static const uint32_t budgets[] = {16, 22, 32, 44, 52, 64};
+    float* w = malloc(VERTICES * 4 * sizeof(float));
+    float* decoded = malloc(VERTICES * 4 * sizeof(float));
+    uint64_t* codes = malloc(VERTICES * sizeof(uint64_t));
+    for (uint32_t k = 2; k <= 4; ++k) {
+        for (size_t v = 0; v < VERTICES; ++v) {
+            float* vertex = w + v * k;
+            for (uint32_t i = 0; i < k; ++i) vertex[i] = 0.0f;
+            vertex[0] = one_weight_w0(v);
+            if (v % 7 == 0) vertex[k - 1] = v % 14 ? -0.0f : 1e-45f; /* not one weight */
+            if (v % 17 == 0) vertex[1] = vertex[0], vertex[0] = 0.0f;
+            int sparse = v >= VERTICES / 2 && v < VERTICES / 2 + 8192; /* chunks the shortcut skips */
+            if (v % 5 == 0 || (sparse && v % 9)) /* a plain many-weight vertex */
+                for (uint32_t i = 0; i < k; ++i) vertex[i] = (float)(k - i) / (float)(k * (k + 1) / 2);
+        }
+        for (size_t b = 0; b < sizeof(budgets) / sizeof(budgets[0]); ++b) {
+            sp_codec c;
+            CHECK(sp_codec_from_bits(SP_METHOD_OSS, k, budgets[b], &c) == SP_OK);
+            compare_with_pack(&c, w, VERTICES, "one weight");
+            CHECK(sp_encode_weights_batch_isa(&c, w, VERTICES, codes, NULL, SP_ISA_SCALAR) == SP_OK);
+            size_t valid = 0; /* unsorted weights wrap past max_code, which a decode refuses */
+            for (size_t v = 0; v < VERTICES; ++v)
+                if (codes[v] <= c.max_code) codes[valid++] = codes[v];
+            CHECK(sp_decode_weights_batch_isa(&c, codes, valid, decoded, NULL, SP_ISA_SCALAR) == SP_OK);
+            int before = check_failures;
+            for (size_t v = 0; v < valid && check_failures - before < 5; ++v) {
+                float expected[4];
+                sp_oss_decode_one(&c, codes[v], expected);
+                CHECK_MSG(memcmp(decoded + v * k, expected, k * sizeof(float)) == 0,
+                          "one weight decode K=%u %u bits vertex %zu (code %llu)", k, budgets[b], v,
+                          (unsigned long long)codes[v]);
+            }
+        }
+    }
+    free(w), free(decoded), free(codes);
+}
+
 int main(void)
 {
     modular_forms();
     negative_zeros();
+    one_weight_vertices();
     return check_report("test_oss_scalar_encode");
 }
