@@ -35,13 +35,23 @@ static uint64_t next_random(void)
     return rng;
 }
 
-/* The paper's influence mix (51 % one, 22 % two, 13 % three, 14 % four weights), sorted,
- * with neighbouring joints as in a real rig. */
-static void make_influences(size_t count, uint16_t* joints, float* weights)
+/* How many weights a vertex has: the paper's influence mix (51 % one, 22 % two, 13 % three,
+ * 14 % four weights), or with --one-weight P, P % one and the rest in the paper's proportions
+ * of two, three and four (22 : 13 : 14), for the shortcuts one-weight vertices take. */
+static size_t influence_count(int one_weight_percent)
+{
+    uint64_t r = next_random() % 100;
+    if (one_weight_percent < 0) return r < 51 ? 1 : r < 73 ? 2 : r < 86 ? 3 : 4;
+    if (r < (uint64_t)one_weight_percent) return 1;
+    uint64_t rest = next_random() % 49;
+    return rest < 22 ? 2 : rest < 35 ? 3 : 4;
+}
+
+/* The influences, sorted, with neighbouring joints as in a real rig. */
+static void make_influences(size_t count, int one_weight_percent, uint16_t* joints, float* weights)
 {
     for (size_t v = 0; v < count; ++v) {
-        uint64_t r = next_random() % 100;
-        size_t n = r < 51 ? 1 : r < 73 ? 2 : r < 86 ? 3 : 4;
+        size_t n = influence_count(one_weight_percent);
         uint16_t bone = (uint16_t)(v * 64 / count);
         float raw[4] = {0, 0, 0, 0}, sum = 0;
         for (size_t i = 0; i < n; ++i) {
@@ -66,6 +76,7 @@ typedef struct bench_options {
     int json;
     size_t count;
     int repeats;
+    int one_weight_percent; /* -1: the paper's mix */
     sp_isa isa;
 } bench_options;
 
@@ -73,11 +84,20 @@ static const char* const isa_names[] = {"scalar", "avx2", "avx512"};
 
 static int parse_options(int argc, char** argv, bench_options* o)
 {
-    o->json = 0, o->count = 1000000, o->repeats = DEFAULT_REPEATS, o->isa = SP_ISA_AVX512;
+    o->json = 0, o->count = 1000000, o->repeats = DEFAULT_REPEATS, o->one_weight_percent = -1, o->isa = SP_ISA_AVX512;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0) o->json = 1;
         else if (strcmp(argv[i], "--vertices") == 0 && i + 1 < argc) o->count = strtoull(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) o->repeats = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--one-weight") == 0 && i + 1 < argc) {
+            char* end;
+            long percent = strtol(argv[++i], &end, 10);
+            if (*end || end == argv[i] || percent < 0 || percent > 100) {
+                fprintf(stderr, "Error: --one-weight %s: expected a percentage from 0 to 100\n", argv[i]);
+                return 0;
+            }
+            o->one_weight_percent = (int)percent;
+        }
         else if (strcmp(argv[i], "--isa") == 0 && i + 1 < argc) {
             const char* name = argv[++i];
             int found = -1;
@@ -89,7 +109,8 @@ static int parse_options(int argc, char** argv, bench_options* o)
             }
             o->isa = (sp_isa)found;
         } else {
-            fprintf(stderr, "usage: skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512]\n");
+            fprintf(stderr, "usage: skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512] "
+                            "[--one-weight P]\n");
             return 0;
         }
     }
@@ -246,15 +267,16 @@ static void narrow(const bench_options* o, bench_buffers* b, uint32_t k)
 static void print_header(const bench_options* o, sp_isa isa, sp_isa cpu, double copy, bench_rate lut, size_t lut_size)
 {
     if (o->json) {
-        printf("{\"vertices\": %zu, \"repeats\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
+        printf("{\"vertices\": %zu, \"repeats\": %d, \"one_weight_percent\": %d, \"isa\": \"%s\", \"cpu_isa\": \"%s\", "
                "\"memcpy_bytes_per_vertex\": %d, \"memcpy_vertices_per_s\": %.0f, \"lut_build_vertices_per_s\": %.0f, "
                "\"lut_build_ratio\": %.3f, \"lut_size\": %zu, \"codecs\": [",
-               o->count, o->repeats, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy, lut.per_s, lut.ratio,
-               lut_size);
+               o->count, o->repeats, o->one_weight_percent, isa_names[isa], isa_names[cpu], INPUT_BYTES_PER_VERTEX, copy,
+               lut.per_s, lut.ratio, lut_size);
         return;
     }
     printf("skinpack bench: %zu vertices, single thread, median of %d, vector path %s (CPU: %s)\n", o->count,
            o->repeats, isa_names[isa], isa_names[cpu]);
+    if (o->one_weight_percent >= 0) printf("influences: %d %% one weight, the rest in the paper's proportions\n", o->one_weight_percent);
     printf("memcpy (16 B/vertex)  %8.1f M vertices/s\n", copy / 1e6);
     printf("tuple table build     %8.1f M vertices/s  (%.3fx memcpy, %zu tuples)\n\n", lut.per_s / 1e6, lut.ratio,
            lut_size);
@@ -291,7 +313,7 @@ int skinpack_cmd_bench(int argc, char** argv)
         release(&b);
         return 1;
     }
-    make_influences(o.count, b.joints, b.weights);
+    make_influences(o.count, o.one_weight_percent, b.joints, b.weights);
     for (size_t i = 0; i < o.count * INPUT_BYTES_PER_VERTEX; ++i) b.copy_src[i] = (unsigned char)next_random();
     sp_isa cpu = sp_cpu_isa(), isa = cpu < o.isa ? cpu : o.isa;
     double copy = memcpy_rate(&o, &b);
