@@ -217,8 +217,8 @@ SP_INLINE double oss_encode_vertex(const sp_codec* codec, const oss_pack_form* f
  * ~1/5 of a chunk's vertices have one weight. After a chunk with fewer than 1/4 the next
  * ONE_WEIGHT_SKIP chunks go unlisted (their one-weight vertices take the general path, with the
  * same result): a mesh without one-weight vertices lists one chunk in ONE_WEIGHT_SKIP + 1 and
- * runs ~3 % slower than without the shortcut, one of the paper's mix 1.5x (encode) to 1.7x
- * (decode) faster (docs/benchmarks.md, session 14). */
+ * encodes up to ~6 % slower than without the shortcut, one of the paper's mix (51 %) 1.3-1.5x
+ * faster to encode and 1.5-2.2x to decode (K = 3, 4; docs/benchmarks.md, session 14). */
 #define ONE_WEIGHT_SKIP 7
 
 SP_INLINE size_t oss_chunks_to_skip(size_t ones, size_t size)
