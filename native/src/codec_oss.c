@@ -233,18 +233,17 @@ SP_INLINE size_t oss_listed_at(const uint32_t* others, size_t i)
     return others ? others[i] : i;
 }
 
-/* 1 unless the vertex is a one-weight vertex (above): sp_grid_plain's test on w0 alone, and the
- * other weights' bits 0, in one compare (those bits, if any, put the key at 2^32 or more). */
+/* 1 unless the vertex is a one-weight vertex (above): w0 passes sp_grid_plain and the other
+ * weights' bits are all 0. */
 SP_INLINE size_t oss_not_one_weight(const float* vertex, uint32_t k)
 {
-    uint32_t first, rest = 0;
-    memcpy(&first, &vertex[0], sizeof(first));
+    uint32_t rest = 0;
     SP_UNROLL for (uint32_t i = 1; i < k; ++i) {
         uint32_t bits;
         memcpy(&bits, &vertex[i], sizeof(bits));
         rest |= bits;
     }
-    return ((uint64_t)rest << 32 | (uint32_t)(first - 1)) >= 0x7F7FFFFFu;
+    return (size_t)((rest != 0) | !sp_grid_plain(vertex, 1));
 }
 
 /* The code of a one-weight vertex and its count of significant weights. */
@@ -305,12 +304,11 @@ SP_INLINE void oss_encode_chunks(const sp_codec* codec, const float* weights, si
     uint8_t one_significant;
     uint64_t one_code = oss_one_weight_code(codec, &one_significant);
     uint32_t others[ONE_WEIGHT_CHUNK];
-    size_t skipped = 0;
-    for (size_t start = first, end; start < count; start = end) {
-        size_t size = skipped ? skipped * ONE_WEIGHT_CHUNK : ONE_WEIGHT_CHUNK, listed;
-        end = count - start < size ? count : start + size;
+    size_t skipped = 0; /* chunks left to encode unlisted (oss_chunks_to_skip) */
+    for (size_t start = first; start < count; start += ONE_WEIGHT_CHUNK) {
+        size_t end = count - start < ONE_WEIGHT_CHUNK ? count : start + ONE_WEIGHT_CHUNK, listed = end - start;
         if (skipped) {
-            listed = end - start, skipped = 0;
+            --skipped;
         } else {
             listed = oss_list_others(weights, start, end, k, one_code, one_significant, codes, significant, others);
             skipped = oss_chunks_to_skip(end - start - listed, end - start);
@@ -528,14 +526,6 @@ void sp_oss_unpack(uint64_t n, uint32_t k, uint64_t code, uint64_t* q)
  * since about half of a rig's codes are that one). */
 #define SCALAR_CHUNK 32
 
-/* The weights of the one-weight code, as the stages below would write them. */
-static void oss_one_weight_weights(const sp_codec* codec, uint64_t one_code, double inverse, float* one)
-{
-    uint64_t q[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-    sp_oss_unpack(codec->n, codec->influences, one_code, q);
-    for (uint32_t i = 0; i < codec->influences; ++i) one[i] = (float)((double)q[i] * inverse);
-}
-
 /* The codes oss_listed_at(others, 0..listed-1) of a chunk (at `codes`, weights at `weights`),
  * K = 3 or 4, all valid: the layer stage, then the row stage. */
 SP_INLINE void oss_decode_listed(uint64_t n, double inverse, const uint64_t* codes, const uint32_t* others,
@@ -585,7 +575,7 @@ SP_INLINE size_t oss_decode_run(const sp_codec* codec, const uint64_t* codes, si
     }
     uint64_t one_code = oss_one_weight_code(codec, NULL);
     float one[SP_MAX_INFLUENCES] = {0, 0, 0, 0};
-    oss_one_weight_weights(codec, one_code, inverse, one);
+    sp_oss_decode_one(codec, one_code, one); /* sp_grid_to_weights: the stages' own arithmetic */
     uint32_t others[SCALAR_CHUNK];
     size_t skipped = 0; /* chunks left to decode unlisted (oss_chunks_to_skip) */
     for (size_t v = first; v < count;) {
