@@ -601,16 +601,24 @@ SP_INLINE SIMD_FN void u_compact(uvec a, unsigned keep, uint64_t* out)
     _mm256_storeu_si256((__m256i*)out, _mm256_permutevar8x32_epi32(a, permute));
 }
 
-/* The first two weights of four vertices of k floats (the doubles' roundings to float), each
- * row's others left as they are. */
+/* Four whole rows of k floats, each the first two weights (the doubles' roundings to float) and
+ * zeros, permuted from both weights in one register (a's in lanes 0-3, b's in 4-7): K = 4 as the
+ * (w0, w1) pairs of vertices 0, 2 | 1, 3, each unpacked with a zero pair; K = 3 into the rows'
+ * places (float p is vertex p / 3's weight p % 3), the zeros blended in. */
 SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float* out)
 {
     __m128 a = _mm256_cvtpd_ps(first), b = _mm256_cvtpd_ps(second);
-    __m128 low = _mm_unpacklo_ps(a, b), high = _mm_unpackhi_ps(a, b);
-    _mm_storel_pi((__m64*)out, low);
-    _mm_storeh_pi((__m64*)(out + k), low);
-    _mm_storel_pi((__m64*)(out + 2 * k), high);
-    _mm_storeh_pi((__m64*)(out + 3 * k), high);
+    __m256 both = _mm256_insertf128_ps(_mm256_castps128_ps256(a), b, 1), zero = _mm256_setzero_ps();
+    if (k == 4) {
+        __m256d pairs = _mm256_castps_pd(_mm256_permutevar8x32_ps(both, _mm256_setr_epi32(0, 4, 2, 6, 1, 5, 3, 7)));
+        _mm256_storeu_pd((double*)out, _mm256_unpacklo_pd(pairs, _mm256_castps_pd(zero)));       /* vertices 0, 1 */
+        _mm256_storeu_pd((double*)(out + 8), _mm256_unpackhi_pd(pairs, _mm256_castps_pd(zero))); /* 2, 3 */
+    } else {
+        __m256 head = _mm256_permutevar8x32_ps(both, _mm256_setr_epi32(0, 4, 0, 1, 5, 0, 2, 6));
+        __m256 tail = _mm256_permutevar8x32_ps(both, _mm256_setr_epi32(0, 3, 7, 0, 0, 0, 0, 0));
+        _mm256_storeu_ps(out, _mm256_blend_ps(head, zero, 0x24));
+        _mm_storeu_ps(out + 8, _mm256_castps256_ps128(_mm256_blend_ps(tail, zero, 0x09)));
+    }
 }
 
 /* The lanes' numbers 0, 1, ... of a block. */

@@ -432,9 +432,9 @@ SP_INLINE SIMD_FN void u_compact(uvec a, unsigned keep, uint64_t* out)
     _mm512_storeu_si512(out, _mm512_maskz_compress_epi64((__mmask8)keep, a));
 }
 
-/* The first two weights of eight vertices of k floats (the doubles' roundings to float), each
- * row's others left as they are: two-source permutes into the rows' places, stored under masks
- * of those places (K = 3: float p of the rows is vertex p / 3's weight p % 3, none where 2). */
+/* Eight whole rows of k floats, each the first two weights (the doubles' roundings to float) and
+ * zeros: two-source permutes into the rows' places, zero where masked off (K = 3: float p of
+ * the rows is vertex p / 3's weight p % 3, zero where 2). */
 SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float* out)
 {
     __m256 a = _mm512_cvtpd_ps(first), b = _mm512_cvtpd_ps(second);
@@ -442,13 +442,13 @@ SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float
     if (k == 4) {
         __m512i low = _mm512_setr_epi32(0, 16, 0, 0, 1, 17, 0, 0, 2, 18, 0, 0, 3, 19, 0, 0);
         __m512i high = _mm512_setr_epi32(4, 20, 0, 0, 5, 21, 0, 0, 6, 22, 0, 0, 7, 23, 0, 0);
-        _mm512_mask_storeu_ps(out, 0x3333, _mm512_permutex2var_ps(wide_a, low, wide_b));
-        _mm512_mask_storeu_ps(out + 16, 0x3333, _mm512_permutex2var_ps(wide_a, high, wide_b));
+        _mm512_storeu_ps(out, _mm512_maskz_permutex2var_ps(0x3333, wide_a, low, wide_b));
+        _mm512_storeu_ps(out + 16, _mm512_maskz_permutex2var_ps(0x3333, wide_a, high, wide_b));
     } else {
         __m512i head = _mm512_setr_epi32(0, 16, 0, 1, 17, 0, 2, 18, 0, 3, 19, 0, 4, 20, 0, 5);
         __m256i tail = _mm256_setr_epi32(13, 0, 6, 14, 0, 7, 15, 0); /* floats 16-23: a's are 0-7, b's 8-15 */
-        _mm512_mask_storeu_ps(out, 0xB6DB, _mm512_permutex2var_ps(wide_a, head, wide_b));
-        _mm256_mask_storeu_ps(out + 16, 0x6D, _mm256_permutex2var_ps(a, tail, b));
+        _mm512_storeu_ps(out, _mm512_maskz_permutex2var_ps(0xB6DB, wide_a, head, wide_b));
+        _mm256_storeu_ps(out + 16, _mm256_maskz_permutex2var_ps(0x6D, a, tail, b));
     }
 }
 

@@ -40,8 +40,8 @@
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
  *   for the edge codes' decode: u_bound(n) and u_at_least(a, bound) (the lanes of a >= n, as
  *   bits), u_compact(a, keep, out) (the lanes kept, in order, to the front of out),
- *   u_lane_numbers() (0, 1, ... BLOCK - 1), store_edge_pairs(first, second, k, out) (two weights a row, the rest of
- *   each row left)
+ *   u_lane_numbers() (0, 1, ... BLOCK - 1), store_edge_pairs(first, second, k, out) (whole rows: two
+ *   weights, the rest zeros)
  * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
  *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
@@ -779,12 +779,23 @@ SP_INLINE int split_decode(const sp_codec* codec, uint32_t k)
 
 /* One block's rest w = code - u(k) (exact in double: integers below 2^50), clamped to
  * [-1, 2^31 - 1], and the row root's argument apex^2 + 3 - 12 (w + 7/8) with
- * apex = 2 (N - 2k) + 1 (exact below 2^36). */
-SP_INLINE SIMD_FN vec split_rest(double n, vec code, vec layer, vec* mirrored)
+ * apex = 2 (N - 2k) + 1 (exact below 2^36). The float root's layer k (n_layer_finish: a quarter
+ * of a float sum near 2N, good to about an ulp, 2^-8 of a layer at 44 bits) is one too high for
+ * the codes that close to their layer's end (one in 400 of the bench's mix at 44 bits), where
+ * w < 0: those lanes step down a layer (*stepped set), whose rest is exact as above, instead of
+ * going to the scalar redo (~4 % of the decode's time at 44 bits); a lane still outside its
+ * layer fails the row check. */
+SP_INLINE SIMD_FN vec split_rest(double n, vec code, vec* layer, vec* mirrored, int* stepped)
 {
-    vec w = v_sub(code, layer_base(n, layer));
+    vec w = v_sub(code, layer_base(n, *layer));
+    mask below = m_lt(w, v_zero());
+    if (m_bits(below)) { /* rare: no lane in most blocks */
+        *layer = v_add_where(*layer, below, v_splat(-1.0));
+        w = v_sub(code, layer_base(n, *layer));
+        *stepped = 1;
+    }
     w = v_min(v_max(w, v_splat(-1.0)), v_splat(2147483647.0));
-    vec apex = v_fnmadd(layer, v_splat(4.0), v_splat(2 * n + 1));
+    vec apex = v_fnmadd(*layer, v_splat(4.0), v_splat(2 * n + 1));
     *mirrored = v_fnmadd(w, v_splat(12.0), v_fmsub(apex, apex, v_splat(7.5)));
     return w;
 }
@@ -851,9 +862,11 @@ SP_INLINE SIMD_FN int decode_chunk_split(const sp_codec* codec, const void* cons
     for (size_t b = 0; b < blocks; ++b) layers[b] = n_layer_finish(n, x[b], z[b], 0.0);
     for (size_t b = 0; b < blocks; ++b) {
         vec low, high, first, second;
+        int stepped = 0;
         v_from_i_pair(layers[b], &low, &high);
-        rest[b] = i_from_pair(split_rest(n, v_from_u(u_load(codes + b * NBLOCK)), low, &first),
-                              split_rest(n, v_from_u(u_load(codes + b * NBLOCK + BLOCK)), high, &second));
+        rest[b] = i_from_pair(split_rest(n, v_from_u(u_load(codes + b * NBLOCK)), &low, &first, &stepped),
+                              split_rest(n, v_from_u(u_load(codes + b * NBLOCK + BLOCK)), &high, &second, &stepped));
+        if (stepped) layers[b] = i_from_pair(low, high);
         mirrored[b] = f_from_pair(first, second);
     }
     for (size_t b = 0; b < blocks; ++b) { /* a stage of its own: the root's chain is long */
@@ -913,8 +926,7 @@ SP_INLINE unsigned lane_count(unsigned bits)
 #define EDGE_TWO_PASSES() ((void)0)
 #endif
 
-/* A chunk's buffer: its rows (past each row's first two weights zero while unused) and the
- * vertices whose rows the list's weights took (to be zeroed again). */
+/* A chunk's buffer: its rows and the vertices whose rows the list's weights take. */
 typedef struct edge_buffer {
     float rows[EDGE_CHUNK * SP_MAX_INFLUENCES];
     uint64_t at[EDGE_LIST];
@@ -931,7 +943,6 @@ typedef struct edge_list {
     size_t padded;       /* codes in the list rounded up to NBLOCK lanes */
     unsigned filling;    /* the buffer the next chunk fills */
     float* pending;      /* where the other buffer's rows go, or NULL */
-    int zeroed;          /* whether the buffers' rows are zero past their first two weights yet */
 } edge_list;
 
 /* Whether edge codes are decoded apart: K = 3 and 4 past the narrow lanes. In the narrow lanes
@@ -951,22 +962,13 @@ SP_INLINE SIMD_FN int edge_chunk_pays(const uint64_t* codes, uint64_t n)
     return EDGE_SAMPLE - others >= EDGE_MIN;
 }
 
-/* The pending buffer's rows that the list's weights took back to zero past the first two, and
- * nothing pending. */
-SP_INLINE SIMD_FN void edge_sent(edge_list* list, uint32_t k)
-{
-    edge_buffer* sent = &list->buffer[list->filling ^ 1];
-    for (size_t i = 0; i < sent->count; ++i) memset(sent->rows + sent->at[i] * k + 2, 0, (k - 2) * sizeof(float));
-    list->pending = NULL;
-}
-
 /* The pending buffer (if any) to the weights at once (EDGE_CHUNK k floats: whole 8-float stores). */
 SP_INLINE SIMD_FN void edge_flush(edge_list* list, uint32_t k, const simd_layout* layout)
 {
     if (!list->pending) return;
     const float* rows = list->buffer[list->filling ^ 1].rows;
     for (size_t i = 0; i < EDGE_CHUNK * k; i += 8) put8(layout, list->pending + i, _mm256_loadu_ps(rows + i));
-    edge_sent(list, k);
+    list->pending = NULL;
 }
 
 /* Every lane of a chunk decoded as an edge code into the filling buffer, the other codes listed
@@ -979,10 +981,6 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
 {
     vec inverse = v_splat(1.0 / (double)codec->scale), scale = v_splat((double)codec->scale);
     uvec bound = u_bound(codec->n), at = u_lane_numbers(), step = u_splat(BLOCK);
-    if (!list->zeroed) { /* the first chunk that pays, not every call: most batches of odd codes have none */
-        for (unsigned b = 0; b < 2; ++b) memset(list->buffer[b].rows, 0, sizeof list->buffer[b].rows);
-        list->zeroed = 1;
-    }
     edge_buffer* filling = &list->buffer[list->filling];
     float *rows = filling->rows, *pending = list->pending;
     const float* sending = list->buffer[list->filling ^ 1].rows;
@@ -1004,7 +1002,7 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
             for (size_t i = 0; i < 2 * k * BLOCK; i += 8)
                 put8(layout, pending + (v - BLOCK) * k + i, _mm256_loadu_ps(sending + (v - BLOCK) * k + i));
     }
-    if (pending) edge_sent(list, k);
+    list->pending = NULL;
     filling->count = listed;
     for (list->padded = listed; list->padded % NBLOCK; ++list->padded) list->codes[list->padded] = list->codes[listed - 1];
 }
@@ -1014,8 +1012,9 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
 SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
 {
     edge_buffer* filling = &list->buffer[list->filling];
-    for (size_t i = 0; i < filling->count; ++i)
-        memcpy(filling->rows + filling->at[i] * k, list->weights + i * k, k * sizeof(float));
+    float* rows = filling->rows; /* locals: the rows' stores could alias the count */
+    const uint64_t* at = filling->at;
+    for (size_t i = 0, count = filling->count; i < count; ++i) memcpy(rows + at[i] * k, list->weights + i * k, k * sizeof(float));
     list->pending = out;
     list->filling ^= 1;
 }
@@ -1030,7 +1029,7 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
         if (!edge_decode(codec, k) || count < EDGE_CHUNK)                                                             \
             return range(codec, constants, codes, count, weights, k, layout);                                          \
         edge_list list;                                                                                                \
-        list.filling = 0, list.pending = NULL, list.zeroed = 0;                                                        \
+        list.filling = 0, list.pending = NULL;                                                                         \
         simd_layout plain = *layout;                                                                                   \
         plain.stream = 0;                                                                                              \
         for (size_t v = 0; v < count; v += EDGE_CHUNK) {                                                               \
