@@ -621,7 +621,19 @@ SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float
     }
 }
 
-/* The lanes' numbers 0, 1, ... of a block. */
-SP_INLINE SIMD_FN uvec u_lane_numbers(void) { return _mm256_setr_epi64x(0, 1, 2, 3); }
+/* A block's vertex numbers in 32-bit lanes: 0, 1, ... BLOCK - 1, each BLOCK more, and those
+ * kept, in order, to the front of out (a whole block written; the permutes from a table of the
+ * 16 lane sets). */
+typedef __m128i vertex_lanes;
+SP_INLINE SIMD_FN vertex_lanes vertex_numbers(void) { return _mm_setr_epi32(0, 1, 2, 3); }
+SP_INLINE SIMD_FN vertex_lanes vertex_numbers_next(vertex_lanes a) { return _mm_add_epi32(a, _mm_set1_epi32(BLOCK)); }
+SP_INLINE SIMD_FN void vertex_compact(vertex_lanes a, unsigned keep, uint32_t* out)
+{
+    static const int32_t order[16][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0},
+                                         {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
+                                         {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+    __m128i permute = _mm_loadu_si128((const __m128i*)order[keep & 15]);
+    _mm_storeu_si128((__m128i*)out, _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(a), permute)));
+}
 #endif
 #endif

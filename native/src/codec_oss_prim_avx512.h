@@ -452,7 +452,14 @@ SP_INLINE SIMD_FN void store_edge_pairs(vec first, vec second, uint32_t k, float
     }
 }
 
-/* The lanes' numbers 0, 1, ... of a block. */
-SP_INLINE SIMD_FN uvec u_lane_numbers(void) { return _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7); }
+/* A block's vertex numbers in 32-bit lanes: 0, 1, ... BLOCK - 1, each BLOCK more, and those
+ * kept, in order, to the front of out (a whole block written). */
+typedef __m256i vertex_lanes;
+SP_INLINE SIMD_FN vertex_lanes vertex_numbers(void) { return _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7); }
+SP_INLINE SIMD_FN vertex_lanes vertex_numbers_next(vertex_lanes a) { return _mm256_add_epi32(a, _mm256_set1_epi32(BLOCK)); }
+SP_INLINE SIMD_FN void vertex_compact(vertex_lanes a, unsigned keep, uint32_t* out)
+{
+    _mm256_storeu_si256((__m256i*)out, _mm256_maskz_compress_epi32((__mmask8)keep, a));
+}
 #endif
 #endif

@@ -40,8 +40,9 @@
  *   root, root_start(x), root_finish(x, r) ~ cbrt(x) + 1/cbrt(x) for the layer estimate
  *   for the edge codes' decode: u_bound(n) and u_at_least(a, bound) (the lanes of a >= n, as
  *   bits), u_compact(a, keep, out) (the lanes kept, in order, to the front of out),
- *   u_lane_numbers() (0, 1, ... BLOCK - 1), store_edge_pairs(first, second, k, out) (whole rows: two
- *   weights, the rest zeros)
+ *   vertex_lanes, vertex_numbers() (0, 1, ... BLOCK - 1 in 32-bit lanes), vertex_numbers_next(a)
+ *   (each BLOCK more), vertex_compact(a, keep, out) (as u_compact), store_edge_pairs(first,
+ *   second, k, out) (whole rows: two weights, the rest zeros)
  * and for decode in 32-bit lanes, NBLOCK (2 BLOCK) lanes and NARROW_CHUNK blocks a stage:
  *   nvec, nint, nmask  float lanes, int32 lanes, a mask of them
  *   f_splat f_add f_sub f_mul f_sqrt f_fmadd f_fnmadd, i_splat i_add i_sub i_mullo i_max i_min,
@@ -926,10 +927,13 @@ SP_INLINE unsigned lane_count(unsigned bits)
 #define EDGE_TWO_PASSES() ((void)0)
 #endif
 
-/* A chunk's buffer: its rows and the vertices whose rows the list's weights take. */
+/* A chunk's buffer: its rows and the vertices whose rows the list's weights take (32-bit: a
+ * block's compacted numbers are then one 16- or 32-byte store, where 64-bit ones took stores
+ * twice as wide, most of AVX-512's across two lines; without those stores at all the edge
+ * decode ran at most ~8 % faster). */
 typedef struct edge_buffer {
     float rows[EDGE_CHUNK * SP_MAX_INFLUENCES];
-    uint64_t at[EDGE_LIST];
+    uint32_t at[EDGE_LIST];
     size_t count;
 } edge_buffer;
 
@@ -980,11 +984,13 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
                                   edge_list* list)
 {
     vec inverse = v_splat(1.0 / (double)codec->scale), scale = v_splat((double)codec->scale);
-    uvec bound = u_bound(codec->n), at = u_lane_numbers(), step = u_splat(BLOCK);
+    uvec bound = u_bound(codec->n);
+    vertex_lanes at = vertex_numbers();
     edge_buffer* filling = &list->buffer[list->filling];
     float *rows = filling->rows, *pending = list->pending;
     const float* sending = list->buffer[list->filling ^ 1].rows;
-    uint64_t *listed_codes = list->codes, *listed_at = filling->at;
+    uint64_t* listed_codes = list->codes;
+    uint32_t* listed_at = filling->at;
     size_t listed = 0;
     for (size_t v = 0; v < EDGE_CHUNK; v += BLOCK) {
         prefetch_ahead(codes + v, sizeof(uint64_t), BLOCK);
@@ -993,9 +999,9 @@ SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, 
         unsigned others = u_at_least(code, bound);
         store_edge_pairs(v_mul(v_sub(scale, c), inverse), v_mul(c, inverse), k, rows + v * k);
         u_compact(code, others, listed_codes + listed);
-        u_compact(at, others, listed_at + listed);
+        vertex_compact(at, others, listed_at + listed);
         listed += lane_count(others);
-        at = u_add(at, step);
+        at = vertex_numbers_next(at);
         if (pending && k * BLOCK % 8 == 0) /* whole stores a block (constants: the tests fold) */
             for (size_t i = 0; i < k * BLOCK; i += 8) put8(layout, pending + v * k + i, _mm256_loadu_ps(sending + v * k + i));
         else if (pending && v % (2 * BLOCK)) /* K = 3 on AVX2: whole stores every other block */
@@ -1013,7 +1019,7 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
 {
     edge_buffer* filling = &list->buffer[list->filling];
     float* rows = filling->rows; /* locals: the rows' stores could alias the count */
-    const uint64_t* at = filling->at;
+    const uint32_t* at = filling->at;
     for (size_t i = 0, count = filling->count; i < count; ++i) memcpy(rows + at[i] * k, list->weights + i * k, k * sizeof(float));
     list->pending = out;
     list->filling ^= 1;

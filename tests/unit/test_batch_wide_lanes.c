@@ -6,7 +6,8 @@
  * ISA's driver is compiled into the test with the scalar redo counted: every output still
  * bit-identical, and the redone lanes few, for random codes and for the codes around row starts
  * (where K = 3's estimate, half a row low, must take the step up, and K = 4's rows sit deep
- * inside their layer) and layer starts, up to 64-bit codes.
+ * inside their layer) and layer starts, up to 64-bit codes; and K = 4's split lanes
+ * (codec_oss_simd.h, N = 1025 to 80264) at their layers' ends.
  * The same for encode, double and wide lanes, K = 2 to 4, 16- to 64-bit codes: sorted weights of
  * the bench's mix (one to K of them non-zero) and random ones, which the lanes must take every
  * one of (a broken rank, deficit check or layer product that rejected lanes would pass
@@ -142,8 +143,9 @@ static void layer_starts(const sp_codec* c)
 
 /* K = 4 in the split lanes (float layer root, rows in 32-bit lanes): codes in the last 1/256 of
  * 2000 layers (the first ones, spread over the middle, the last ones), where the float root's
- * layer, good to an ulp of ~N/4, is often one too high; the rest stage steps those lanes down,
- * so no more than one in 10^3 may be redone (without the step: 0.5 % at N = 1025, 41 % at 68158). */
+ * layer (a quarter of a float sum near 2N, good to about an ulp: 2^-8 of a layer at 44 bits) is
+ * often one too high; the rest stage steps those lanes down, so no more than one in 10^3 may be
+ * redone (without the step: 0.5 % at N = 1025, 41 % at 68158). */
 static void split_layer_ends(const sp_codec* c)
 {
     uint64_t layers = (c->n + 1) / 2;
