@@ -1,10 +1,11 @@
 /*
  * skinpack bench [--json] [--vertices N] [--repeats R] [--isa scalar|avx2|avx512]: single-thread
  * throughput of every codec's batch encode and decode and of the tuple-table build, as ratios to
- * a memcpy of the 4 float weights (16 bytes a vertex) timed right before each repetition. Rates
- * are medians of R repetitions, ratios the medians of the per-repetition ratios and the best-of
- * ratios (fastest copy / fastest run; the machine may be shared); --isa caps the vector paths (the widest the CPU has by default), so one binary
- * measures every path.
+ * a memcpy of the 4 float weights (16 bytes a vertex) timed right before each repetition. The R
+ * repetitions are rounds over every codec (see time_rows). Rates are medians of R repetitions,
+ * ratios the medians of the per-repetition ratios and the best-of ratios (fastest copy / fastest
+ * run; the machine may be shared); --isa caps the vector paths (the widest the CPU has by
+ * default), so one binary measures every path.
  */
 #include <math.h>
 #include <stdio.h>
@@ -155,7 +156,7 @@ static int allocate(size_t count, bench_buffers* b)
     b->joints = malloc(count * 4 * sizeof(uint16_t));
     b->weights = malloc(count * 4 * sizeof(float));
     b->decoded = malloc(count * 4 * sizeof(float));
-    b->narrowed = malloc(count * 4 * sizeof(float));
+    b->narrowed = malloc(count * (2 + 3 + 4) * sizeof(float));
     b->codes = malloc(count * sizeof(uint64_t));
     b->significant = malloc(count);
     b->tuple_index = malloc(count * sizeof(uint32_t));
@@ -172,6 +173,12 @@ static void release(bench_buffers* b)
 {
     free(b->joints), free(b->weights), free(b->decoded), free(b->narrowed), free(b->codes), free(b->significant);
     free(b->tuple_index), free(b->lut), free(b->scratch), free(b->copy_src), free(b->copy_dst);
+}
+
+/* The K-wide weights in `narrowed` (K = 2, 3, 4 one after the other: offsets 0, 2 and 5 counts). */
+static float* narrowed_for(const bench_options* o, bench_buffers* b, uint32_t k)
+{
+    return b->narrowed + o->count * (k - 2) * (k + 1) / 2;
 }
 
 /* One timed memcpy of the weights' bytes (the baseline of every ratio, taken next to what it
@@ -234,33 +241,65 @@ static bench_rate lut_rate(const bench_options* o, bench_buffers* b, size_t* lut
     return summarise(o, t, copy);
 }
 
-/* Encode and decode rates of one codec over the narrowed K-wide weights. */
-static void codec_rates(const bench_options* o, bench_buffers* b, const sp_codec* codec, bench_rate* encode,
-                        bench_rate* decode)
+/* The K heaviest weights of each vertex, renormalised (what a K-influence skin holds), for
+ * K = 2, 3 and 4 one after the other in `narrowed`. */
+static void narrow(const bench_options* o, bench_buffers* b)
 {
-    double te[MAX_REPEATS], td[MAX_REPEATS], copy_e[MAX_REPEATS], copy_d[MAX_REPEATS];
-    for (int r = 0; r < o->repeats; ++r) {
-        copy_e[r] = time_memcpy(o, b, r);
-        double t0 = now_seconds();
-        sp_encode_weights_batch_isa(codec, b->narrowed, o->count, b->codes, NULL, o->isa);
-        te[r] = now_seconds() - t0;
-        copy_d[r] = time_memcpy(o, b, r);
-        t0 = now_seconds();
-        sp_decode_weights_batch_isa(codec, b->codes, o->count, b->decoded, NULL, o->isa);
-        td[r] = now_seconds() - t0;
+    for (uint32_t k = 2; k <= 4; ++k) {
+        float* out = narrowed_for(o, b, k);
+        for (size_t v = 0; v < o->count; ++v) {
+            float sum = 0;
+            for (uint32_t i = 0; i < k; ++i) sum += b->weights[v * 4 + i];
+            for (uint32_t i = 0; i < k; ++i) out[v * k + i] = b->weights[v * 4 + i] / sum;
+        }
     }
-    *encode = summarise(o, te, copy_e);
-    *decode = summarise(o, td, copy_d);
 }
 
-/* The K heaviest weights of each vertex, renormalised: what a K-influence skin holds. */
-static void narrow(const bench_options* o, bench_buffers* b, uint32_t k)
+/* One row of the table: a codec, the budget it was made for and its timings, each next to the
+ * memcpy timed right before it. */
+typedef struct bench_row {
+    sp_codec codec;
+    uint32_t budget;
+    double encode[MAX_REPEATS], decode[MAX_REPEATS], copy_encode[MAX_REPEATS], copy_decode[MAX_REPEATS];
+} bench_row;
+
+static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
+#define BUDGET_COUNT (sizeof(budgets) / sizeof(budgets[0]))
+#define MAX_ROWS (3 * SP_METHOD_COUNT * BUDGET_COUNT) /* K = 2, 3, 4 */
+
+/* Every codec the bench measures (at most MAX_ROWS), in the table's order; returns how many. */
+static size_t make_rows(bench_row* rows)
 {
-    for (size_t v = 0; v < o->count; ++v) {
-        float sum = 0;
-        for (uint32_t i = 0; i < k; ++i) sum += b->weights[v * 4 + i];
-        for (uint32_t i = 0; i < k; ++i) b->narrowed[v * k + i] = b->weights[v * 4 + i] / sum;
-    }
+    size_t count = 0;
+    for (uint32_t k = 2; k <= 4; ++k)
+        for (int m = 0; m < SP_METHOD_COUNT; ++m)
+            for (size_t i = 0; i < BUDGET_COUNT; ++i)
+                if (sp_codec_from_bits((sp_method)m, k, budgets[i], &rows[count].codec) == SP_OK)
+                    rows[count++].budget = budgets[i];
+    return count;
+}
+
+/* Repetition r of one row: its encode and decode, each after a timed memcpy. */
+static void time_row(const bench_options* o, bench_buffers* b, bench_row* row, int r)
+{
+    const float* weights = narrowed_for(o, b, row->codec.influences);
+    row->copy_encode[r] = time_memcpy(o, b, r);
+    double t0 = now_seconds();
+    sp_encode_weights_batch_isa(&row->codec, weights, o->count, b->codes, NULL, o->isa);
+    row->encode[r] = now_seconds() - t0;
+    row->copy_decode[r] = time_memcpy(o, b, r);
+    t0 = now_seconds();
+    sp_decode_weights_batch_isa(&row->codec, b->codes, o->count, b->decoded, NULL, o->isa);
+    row->decode[r] = now_seconds() - t0;
+}
+
+/* Every row's repetitions, as rounds: each round times every row once. A neighbour's burst on
+ * the shared machine (seconds long) then slows one repetition of many rows instead of every
+ * repetition of a few, so each row's best-of figures come from moments spread over the run. */
+static void time_rows(const bench_options* o, bench_buffers* b, bench_row* rows, size_t count)
+{
+    for (int r = 0; r < o->repeats; ++r)
+        for (size_t i = 0; i < count; ++i) time_row(o, b, &rows[i], r);
 }
 
 /* The run's header: the machine's rates as a JSON object's head, or as text lines. */
@@ -308,9 +347,10 @@ int skinpack_cmd_bench(int argc, char** argv)
     bench_options o;
     bench_buffers b;
     if (!parse_options(argc, argv, &o)) return 2;
-    if (!allocate(o.count, &b)) {
+    bench_row* rows = malloc(MAX_ROWS * sizeof(bench_row));
+    if (!allocate(o.count, &b) || !rows) {
         fprintf(stderr, "Error: skinpack bench: out of memory for %zu vertices\n", o.count);
-        release(&b);
+        release(&b), free(rows);
         return 1;
     }
     make_influences(o.count, o.one_weight_percent, b.joints, b.weights);
@@ -319,22 +359,17 @@ int skinpack_cmd_bench(int argc, char** argv)
     double copy = memcpy_rate(&o, &b);
     size_t lut_size = 0;
     bench_rate lut = lut_rate(&o, &b, &lut_size);
+    narrow(&o, &b);
+    size_t row_count = make_rows(rows);
+    time_rows(&o, &b, rows, row_count);
     print_header(&o, isa, cpu, copy, lut, lut_size);
-    int first = 1;
-    static const uint32_t budgets[] = {16, 22, 32, 38, 44, 52, 64};
-    for (uint32_t k = 2; k <= 4; ++k) {
-        narrow(&o, &b, k);
-        for (int m = 0; m < SP_METHOD_COUNT; ++m)
-            for (size_t i = 0; i < sizeof(budgets) / sizeof(budgets[0]); ++i) {
-                sp_codec codec;
-                bench_rate enc, dec;
-                if (sp_codec_from_bits((sp_method)m, k, budgets[i], &codec) != SP_OK) continue;
-                codec_rates(&o, &b, &codec, &enc, &dec);
-                print_row(&o, &codec, budgets[i], m == SP_METHOD_OSS && sp_oss_batch_supported(&codec, isa), enc, dec, first);
-                first = 0;
-            }
+    for (size_t i = 0; i < row_count; ++i) {
+        const sp_codec* codec = &rows[i].codec;
+        int vector = codec->method == SP_METHOD_OSS && sp_oss_batch_supported(codec, isa);
+        print_row(&o, codec, rows[i].budget, vector, summarise(&o, rows[i].encode, rows[i].copy_encode),
+                  summarise(&o, rows[i].decode, rows[i].copy_decode), i == 0);
     }
     if (o.json) printf("]}\n");
-    release(&b);
+    release(&b), free(rows);
     return 0;
 }

@@ -927,27 +927,66 @@ SP_INLINE unsigned lane_count(unsigned bits)
 #define EDGE_TWO_PASSES() ((void)0)
 #endif
 
+/*
+ * Where the buffers lie. A load or store whose address matches a streaming store still in flight
+ * in its low 12 bits (its page offset) waits for that store to leave, and while the first pass
+ * streams, its stores queue. So each chunk's buffers are placed by page offset (edge_place),
+ * EDGE_AHEAD bytes past that of the weights they serve: the filling buffer's rows and vertex
+ * numbers past that of the weights they will stream to, so that when the next pass reads them
+ * back, they lie just ahead of its streaming stores instead of behind them; the list past that of
+ * the chunk's own weights, which is where the pass's stores end, so that the walk reading it
+ * right after the pass does not meet the last of them. Left to their places on the stack, which
+ * the address randomisation sets per process, a quarter (K = 4) to over half (K = 3) of the
+ * places had them behind, and there the edge decode ran 0.34-0.85x as fast as at the best place
+ * (AVX2 and AVX-512, the bench's mix; placed, every place runs within ~10 % of the others, K = 4
+ * faster than the best place did, K = 3 about as fast: docs/benchmarks.md, session 16,
+ * tests/bench/edge_stack_sweep.c). The price: areas a page larger, ~29 KB of stack in all.
+ */
+#define EDGE_PAGE 4096
+#define EDGE_AHEAD 128
+
+/* The 64-byte aligned address in area[0, EDGE_PAGE + 64) at (or just past) the page offset of
+ * `target` + `ahead`. */
+SP_INLINE void* place_at(unsigned char* area, const void* target, size_t ahead)
+{
+    uintptr_t offset = ((uintptr_t)target + ahead - (uintptr_t)area) & (EDGE_PAGE - 1);
+    return (void*)(((uintptr_t)area + offset + 63) & ~(uintptr_t)63);
+}
+
 /* A chunk's buffer: its rows and the vertices whose rows the list's weights take (32-bit: a
  * block's compacted numbers are then one 16- or 32-byte store, where 64-bit ones took stores
  * twice as wide, most of AVX-512's across two lines; without those stores at all the edge
  * decode ran at most ~8 % faster). */
 typedef struct edge_buffer {
-    float rows[EDGE_CHUNK * SP_MAX_INFLUENCES];
-    uint32_t at[EDGE_LIST];
+    float* rows;  /* in `area`, placed by edge_place */
+    uint32_t* at; /* right after the rows, so at the same page offsets */
     size_t count;
+    unsigned char area[EDGE_CHUNK * SP_MAX_INFLUENCES * sizeof(float) + EDGE_LIST * sizeof(uint32_t) + EDGE_PAGE + 64];
 } edge_buffer;
 
 /* The other codes of a chunk, their weights, and two chunk buffers: each chunk's buffer goes to
  * the weights during the next chunk's first pass, so that its stores spread over that pass
  * instead of leaving the chunk at once (AVX2, 1M vertices streamed: ~1.1x). */
 typedef struct edge_list {
-    uint64_t codes[EDGE_LIST];
-    float weights[EDGE_LIST * SP_MAX_INFLUENCES];
+    uint64_t* codes; /* in `area`, placed by edge_place; the weights follow them */
+    float* weights;
     edge_buffer buffer[2];
     size_t padded;       /* codes in the list rounded up to NBLOCK lanes */
     unsigned filling;    /* the buffer the next chunk fills */
     float* pending;      /* where the other buffer's rows go, or NULL */
+    unsigned char area[EDGE_LIST * (sizeof(uint64_t) + SP_MAX_INFLUENCES * sizeof(float)) + EDGE_PAGE + 64];
 } edge_list;
+
+/* The filling buffer and the list placed for the chunk whose weights start at `out`; the two
+ * buffers half a page apart, so that a chunk's rows and the next one's do not share offsets. */
+SP_INLINE void edge_place(edge_list* list, const float* out)
+{
+    edge_buffer* filling = &list->buffer[list->filling];
+    filling->rows = (float*)place_at(filling->area, out, EDGE_AHEAD + list->filling * EDGE_PAGE / 2);
+    filling->at = (uint32_t*)(filling->rows + EDGE_CHUNK * SP_MAX_INFLUENCES);
+    list->codes = (uint64_t*)place_at(list->area, out, EDGE_AHEAD);
+    list->weights = (float*)(list->codes + EDGE_LIST);
+}
 
 /* Whether edge codes are decoded apart: K = 3 and 4 past the narrow lanes. In the narrow lanes
  * the other codes' decode is too cheap to pay for the two passes (the bench's mix, 1M vertices:
@@ -979,10 +1018,12 @@ SP_INLINE SIMD_FN void edge_flush(edge_list* list, uint32_t k, const simd_layout
  * with their vertices and padded with copies of the last to whole NBLOCK lanes, the pending
  * buffer sent meanwhile. The edge code's weights are sp_grid_to_weights' (c < N is exact, and so
  * is 2(N - 1) - c). No code is checked: an edge code is valid, and the driver's walk checks the
- * list. Locals for everything the stores could alias. */
-SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, uint32_t k, const simd_layout* layout,
-                                  edge_list* list)
+ * list. `out`: where the chunk's weights go (the buffers' places). Locals for everything the
+ * stores could alias. */
+SP_INLINE SIMD_FN void edge_split(const sp_codec* codec, const uint64_t* codes, float* out, uint32_t k,
+                                  const simd_layout* layout, edge_list* list)
 {
+    edge_place(list, out);
     vec inverse = v_splat(1.0 / (double)codec->scale), scale = v_splat((double)codec->scale);
     uvec bound = u_bound(codec->n);
     vertex_lanes at = vertex_numbers();
@@ -1042,7 +1083,7 @@ SP_INLINE SIMD_FN void edge_merge(edge_list* list, uint32_t k, float* out)
             size_t chunk = count - v < EDGE_CHUNK ? count - v : EDGE_CHUNK, done;                                      \
             const uint64_t* in = codes + v;                                                                            \
             if (chunk == EDGE_CHUNK && edge_chunk_pays(in, codec->n)) {                                                \
-                edge_split(codec, in, k, layout, &list);                                                               \
+                edge_split(codec, in, weights + v * k, k, layout, &list);                                              \
                 if (range(codec, constants, list.codes, list.padded, list.weights, k, &plain) == list.padded) {       \
                     edge_merge(&list, k, weights + v * k);                                                             \
                     EDGE_TWO_PASSES();                                                                                 \

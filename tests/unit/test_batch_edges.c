@@ -10,7 +10,8 @@
  * sp_decode_weights and nothing written past the batch, also through the library's dispatch at
  * every 4-byte offset from a line; an invalid code in a chunk's list or at its first vertex,
  * where the walk must stop before it with every vertex up to there decoded; few edge codes and
- * narrow lanes, which must keep the one-pass walk (edge_decode, edge_chunk_pays).
+ * narrow lanes, which must keep the one-pass walk (edge_decode, edge_chunk_pays); and where the
+ * chunk buffers and the list are placed (edge_place).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -167,6 +168,42 @@ static void one_pass(const sp_codec* c, unsigned edges)
     free(codes);
 }
 
+/* The page offset of `p` past that of `from` (0 to EDGE_PAGE - 1). */
+static size_t page_ahead(const void* p, const void* from)
+{
+    return (size_t)(((uintptr_t)p - (uintptr_t)from) & (EDGE_PAGE - 1));
+}
+
+/* The buffers' places (edge_place), for weights at every 4-byte offset of a page: inside their
+ * areas, on 64-byte lines, EDGE_AHEAD bytes (up to the next line) past the page offset of the
+ * weights they serve, the second chunk buffer half a page further, the vertex numbers right after
+ * the rows and the list's weights after its codes. */
+static void placement(void)
+{
+    static edge_list list; /* static: only the addresses are checked */
+    float* page = malloc(2 * EDGE_PAGE);
+    for (size_t offset = 0; offset < EDGE_PAGE; offset += 4)
+        for (unsigned filling = 0; filling < 2; ++filling) {
+            const float* out = (const float*)((const unsigned char*)page + offset);
+            list.filling = filling;
+            edge_place(&list, out);
+            const edge_buffer* b = &list.buffer[filling];
+            size_t rows_ahead = page_ahead(b->rows, out), codes_ahead = page_ahead(list.codes, out);
+            size_t want = EDGE_AHEAD + filling * EDGE_PAGE / 2;
+            CHECK_MSG(rows_ahead >= want && rows_ahead < want + 64 && (uintptr_t)b->rows % 64 == 0,
+                      "offset %zu buffer %u: rows %zu bytes ahead", offset, filling, rows_ahead);
+            CHECK(b->at == (uint32_t*)(b->rows + EDGE_CHUNK * SP_MAX_INFLUENCES));
+            CHECK((const unsigned char*)b->rows >= b->area &&
+                  (const unsigned char*)(b->at + EDGE_LIST) <= b->area + sizeof b->area);
+            CHECK_MSG(codes_ahead >= EDGE_AHEAD && codes_ahead < EDGE_AHEAD + 64 && (uintptr_t)list.codes % 64 == 0,
+                      "offset %zu: list codes %zu bytes ahead", offset, codes_ahead);
+            CHECK(list.weights == (float*)(list.codes + EDGE_LIST));
+            CHECK((const unsigned char*)list.codes >= list.area &&
+                  (const unsigned char*)(list.weights + EDGE_LIST * SP_MAX_INFLUENCES) <= list.area + sizeof list.area);
+        }
+    free(page);
+}
+
 int main(void)
 {
     if (sp_cpu_isa() < LANES_ISA) {
@@ -191,6 +228,7 @@ int main(void)
     sp_codec narrow = oss(4, 1000), narrow_rows = oss(3, 5000);
     one_pass(&narrow, 3);
     one_pass(&narrow_rows, 3);
+    placement();
     return check_report(LANES_TEST);
 }
 #else
