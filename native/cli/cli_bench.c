@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include "../src/codec_internal.h" /* sp_isa and the capped batch forms */
+#include "bench_influences.h"
 #include "commands.h"
 #include "skinpack.h"
 
@@ -36,35 +37,15 @@ static uint64_t next_random(void)
     return rng;
 }
 
-/* How many weights a vertex has: the paper's influence mix (51 % one, 22 % two, 13 % three,
- * 14 % four weights), or with --one-weight P, P % one and the rest in the paper's proportions
- * of two, three and four (22 : 13 : 14), for the shortcuts one-weight vertices take. */
-static size_t influence_count(int one_weight_percent)
-{
-    uint64_t r = next_random() % 100;
-    if (one_weight_percent < 0) return r < 51 ? 1 : r < 73 ? 2 : r < 86 ? 3 : 4;
-    if (r < (uint64_t)one_weight_percent) return 1;
-    uint64_t rest = next_random() % 49;
-    return rest < 22 ? 2 : rest < 35 ? 3 : 4;
-}
-
 /* The influences, sorted, with neighbouring joints as in a real rig. */
 static void make_influences(size_t count, int one_weight_percent, uint16_t* joints, float* weights)
 {
     for (size_t v = 0; v < count; ++v) {
-        size_t n = influence_count(one_weight_percent);
+        size_t n = bench_influence_count(next_random, one_weight_percent);
         uint16_t bone = (uint16_t)(v * 64 / count);
-        float raw[4] = {0, 0, 0, 0}, sum = 0;
-        for (size_t i = 0; i < n; ++i) {
-            raw[i] = (float)(next_random() % 1000 + 1);
-            sum += raw[i];
-        }
-        for (size_t i = 1; i < 4; ++i) /* descending */
-            for (size_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
-                float t = raw[j];
-                raw[j] = raw[j - 1];
-                raw[j - 1] = t;
-            }
+        float raw[4], sum = 0;
+        bench_raw_weights(next_random, n, raw);
+        for (size_t i = 0; i < n; ++i) sum += raw[i];
         for (size_t i = 0; i < 4; ++i) {
             joints[v * 4 + i] = i < n ? (uint16_t)((bone + i) % 64) : 0;
             weights[v * 4 + i] = raw[i] / sum;

@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "../../native/cli/bench_influences.h"
 #include "../../native/src/codec_internal.h"
 #include "../unit/check.h" /* rng_next */
 #include "skinpack.h"
@@ -60,15 +61,8 @@ static int parse(int argc, char** argv, sweep_options* o)
 static void make_weights(const sweep_options* o, float* weights)
 {
     for (size_t v = 0; v < o->vertices; ++v) {
-        uint64_t r = rng_next() % 100;
-        uint32_t count = r < 51 ? 1 : r < 73 ? 2 : r < 86 ? 3 : 4;
-        float raw[4] = {0, 0, 0, 0}, sum = 0;
-        for (uint32_t i = 0; i < count; ++i) raw[i] = (float)(rng_next() % 1000 + 1);
-        for (uint32_t i = 1; i < 4; ++i)
-            for (uint32_t j = i; j > 0 && raw[j - 1] < raw[j]; --j) {
-                float t = raw[j];
-                raw[j] = raw[j - 1], raw[j - 1] = t;
-            }
+        float raw[4], sum = 0;
+        bench_raw_weights(rng_next, bench_influence_count(rng_next, -1), raw);
         for (uint32_t i = 0; i < o->k; ++i) sum += raw[i];
         for (uint32_t i = 0; i < o->k; ++i) weights[v * o->k + i] = raw[i] / sum;
     }
