@@ -152,6 +152,9 @@ void sp_meshlet_plan_init(sp_meshlet_plan* plan, unsigned char** cursor, size_t 
 void sp_meshlet_plan_close(sp_meshlet_context* ctx, sp_meshlet_plan* plan);
 /* qsort order of uint64_t keys, ascending. */
 int sp_meshlet_compare_u64(const void* x, const void* y);
+/* Sorts keys by their high 32 bits, keeping the order of keys with equal high words (temp: count
+ * more entries). For keys whose low words ascend in the input, this is their qsort order. */
+void sp_meshlet_sort_high_words(uint64_t* keys, uint64_t* temp, size_t count);
 /* Group b absorbs group a (a is marked merged; the caller checked every limit). */
 void sp_meshlet_plan_append(sp_meshlet_plan* plan, uint32_t b, uint32_t a);
 /* meshlets_parts.c: scratch bytes for sp_meshlet_plan_close_parts. */

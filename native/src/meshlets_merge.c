@@ -95,6 +95,24 @@ int sp_meshlet_compare_u64(const void* x, const void* y)
     return (a > b) - (a < b);
 }
 
+void sp_meshlet_sort_high_words(uint64_t* keys, uint64_t* temp, size_t count)
+{
+    /* LSD radix sort, 8 bits a pass, stable: the low words keep their order within equal high
+     * words. An even number of passes leaves the result in keys. */
+    for (int shift = 32; shift < 64; shift += 8) {
+        size_t start[257] = {0};
+        for (size_t i = 0; i < count; ++i)
+            start[(keys[i] >> shift & 0xff) + 1]++;
+        for (int b = 0; b < 256; ++b)
+            start[b + 1] += start[b];
+        for (size_t i = 0; i < count; ++i)
+            temp[start[keys[i] >> shift & 0xff]++] = keys[i];
+        uint64_t* swap = keys;
+        keys = temp;
+        temp = swap;
+    }
+}
+
 /* The underfull meshlets (room for a disconnected triangle, or under half the triangle limit):
  * their Morton list (by first triangle) into plan->spatial, and plan->keys = (vertex count << 32
  * | position in that list), smallest first. Returns how many. */

@@ -38,10 +38,10 @@
  * between neighbours (meshlets_exchange.c).
  */
 #include "meshlets_internal.h"
+#include "platform.h"
 
 #include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define NO_TRIANGLE UINT32_MAX
@@ -60,6 +60,7 @@
 #define COMPACT_BORDER 1.0f       /* compact: border vertices <= sqrt(12 x vertices), a hexagonal disc's
                                    * (both with the seed front of better_seed: 0.5 and 0.9 before it) */
 #define BANDED_SHARE 0.9          /* the band cost needs this share of triangles with equal influence counts */
+#define SLOT_WORDS ((SP_MESHLET_MAX_VERTICES + 63) / 64) /* u64 words of a bit per open vertex slot */
 
 typedef struct skin_state {
     uint32_t* adjacency_offset; /* vertex_count + 1: start of each vertex's triangle list */
@@ -71,6 +72,8 @@ typedef struct skin_state {
     uint32_t* rank;             /* triangle -> position in morton[] */
     size_t seed_cursor;         /* morton[] before this position is all emitted */
     uint32_t last_rank;         /* rank of the triangle added last */
+    uint32_t* seen;             /* triangle_count: the best_neighbour call that last ranked it */
+    uint32_t search;            /* that call's number */
     uint32_t* vertex_tuple;     /* vertex_count: global tuple id (sp_meshlet_tuple_ids) */
     uint32_t* tuple_stamp;      /* per tuple id: open_stamp while the open meshlet has the tuple */
     uint32_t open_stamp;        /* changes with every meshlet */
@@ -83,7 +86,8 @@ typedef struct skin_state {
     int regular;                /* growth ranks ties by rings and prefers the meshlet's joints and band (is_regular) */
     uint8_t* influences;        /* vertex_count: used influences of each vertex (regular meshes only) */
     uint32_t open_band;         /* regular: most used influences of an open meshlet's vertex, its palette's floor */
-    uint32_t open_border;       /* regular: open meshlet vertices that still have free triangles */
+    uint32_t open_border;       /* open meshlet vertices that still have free triangles, */
+    uint64_t border[SLOT_WORDS]; /* and their slots: only they have candidates (best_neighbour) */
     int banded;                 /* regular and its influence bands wide (count_influences): the band cost applies */
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
@@ -98,7 +102,7 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
                           sp_meshlet_align8(triangle_count) +                        /* emitted */
                           sp_meshlet_align8(triangle_count * 3 * sizeof(float)) +    /* centroid */
                           sp_meshlet_align8(triangle_count * sizeof(uint64_t)) +     /* morton */
-                          sp_meshlet_align8(triangle_count * sizeof(uint32_t));      /* rank */
+                          2 * sp_meshlet_align8(triangle_count * sizeof(uint32_t));  /* rank, seen */
     size_t tuples = sp_meshlet_align8((tuple_slots + 1) * sizeof(uint32_t)) + /* tuple_stamp */
                     sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
     size_t parts = sp_meshlet_parts_scratch_bound(triangle_count, vertex_count);
@@ -217,7 +221,8 @@ static void build_spatial_order(const sp_meshlet_context* ctx, skin_state* s)
         }
         s->morton[t] = (uint64_t)code << 32 | t;
     }
-    qsort(s->morton, ctx->triangle_count, sizeof(uint64_t), sp_meshlet_compare_u64);
+    /* the plan's sort keys are free until growth ends */
+    sp_meshlet_sort_high_words(s->morton, s->plan.keys, ctx->triangle_count);
     for (size_t i = 0; i < ctx->triangle_count; ++i)
         s->rank[(uint32_t)s->morton[i]] = (uint32_t)i;
 }
@@ -282,12 +287,13 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
                 list[s->live[v]] = t;
                 break;
             }
-        /* regular: the border; a vertex that was in the meshlet leaves it with its last free
-         * triangle, a new one joins it while it has free triangles */
-        if (s->regular && ctx->vertex_slot[v] < first_new)
-            s->open_border -= s->live[v] == 0;
-        else if (s->regular)
-            s->open_border += s->live[v] > 0;
+        /* the border: a vertex that was in the meshlet leaves it with its last free triangle, a
+         * new one joins it while it has free triangles */
+        uint32_t slot = ctx->vertex_slot[v];
+        uint64_t bit = (uint64_t)1 << (slot & 63), *word = s->border + (slot >> 6);
+        uint32_t was = (*word & bit) != 0, now = s->live[v] > 0;
+        *word = now ? *word | bit : *word & ~bit;
+        s->open_border = s->open_border + now - was;
     }
 }
 
@@ -401,6 +407,7 @@ static void flush(sp_meshlet_context* ctx, skin_state* s)
     s->open_tuple_count = 0;
     s->open_band = 0;
     s->open_border = 0;
+    memset(s->border, 0, sizeof(s->border));
 }
 
 /* Tuples triangle t would add to the open meshlet's local LUT. */
@@ -476,10 +483,21 @@ static int below_band(const skin_state* s, const uint32_t* tri)
            s->influences[tri[2]] < s->open_band;
 }
 
+/* The open meshlet's vertices that still have free triangles, in slot order (the order does
+ * matter: best_neighbour returns the first triangle that adds no vertex). Returns how many. */
+static uint32_t border_vertices(const sp_meshlet_context* ctx, const skin_state* s, uint32_t* vertices)
+{
+    uint32_t count = 0;
+    for (uint32_t w = 0; w < SLOT_WORDS; ++w)
+        for (uint64_t bits = s->border[w]; bits != 0; bits &= bits - 1)
+            vertices[count++] = ctx->open_vertices[w * 64 + sp_lowest_bit64(bits)];
+    return count;
+}
+
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
  * limit. The joint and tuple terms are never negative, so a candidate whose topology alone is
  * worse than the best so far is skipped before they are counted. */
-static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
+static candidate best_neighbour(const sp_meshlet_context* ctx, skin_state* s, int require_fit)
 {
     candidate best = {NO_TRIANGLE, 0.0f, 0, 0.0f};
     if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
@@ -496,17 +514,30 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
     }
     if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
         joint_cost += LATE_JOINT_COST;
-    for (uint32_t i = 0; i < ctx->open_vertex_count; ++i) {
-        uint32_t v = ctx->open_vertices[i];
+    if (++s->search == 0) { /* the numbers wrapped: forget the old ones */
+        memset(s->seen, 0, ctx->triangle_count * sizeof(uint32_t));
+        s->search = 1;
+    }
+    uint32_t border[SP_MESHLET_MAX_VERTICES], border_count = border_vertices(ctx, s, border);
+    for (uint32_t i = 0; i < border_count; ++i) {
+        uint32_t v = border[i];
         const uint32_t* list = s->adjacency + s->adjacency_offset[v];
         for (uint32_t j = 0; j < s->live[v]; ++j) {
             uint32_t t = list[j];
+            if (s->seen[t] == s->search)
+                continue; /* ranked already from another of its corners */
+            s->seen[t] = s->search;
             const uint32_t* tri = ctx->indices + (size_t)t * 3;
             uint32_t new_vertices = sp_meshlet_new_vertices(ctx, t);
             if (require_fit && ctx->open_vertex_count + new_vertices > ctx->options.max_vertices)
                 continue;
             float priority = topology_priority(s, tri, new_vertices);
             if (best.triangle != NO_TRIANGLE && priority > best.cost)
+                continue;
+            /* without ranks (irregular mesh), one of the best's priority that lies farther cannot
+             * win: its other terms only add to its cost and scale its distance up */
+            float near = distance_to(s, t, point);
+            if (!s->regular && best.triangle != NO_TRIANGLE && priority == best.cost && near > best.distance)
                 continue;
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
@@ -519,7 +550,7 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, const skin_state*
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             /* among equal costs a candidate that widens the palette counts as farther */
-            float distance = distance_to(s, t, point) * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
+            float distance = near * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
             candidate c = {t, cost, s->regular ? new_joints << 16 | inner_ring(ctx, s, tri) : 0, distance};
             if (cost == 0.0f)
                 return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
@@ -581,6 +612,9 @@ static unsigned char* init_state(sp_meshlet_context* ctx, skin_state* s)
     s->centroid = sp_meshlet_carve(&cursor, t_count * 3 * sizeof(float));
     s->morton = sp_meshlet_carve(&cursor, t_count * sizeof(uint64_t));
     s->rank = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
+    s->seen = sp_meshlet_carve(&cursor, t_count * sizeof(uint32_t));
+    memset(s->seen, 0, t_count * sizeof(uint32_t));
+    s->search = 0;
     s->seed_cursor = 0;
     s->last_rank = 0;
     s->vertex_tuple = sp_meshlet_carve(&cursor, v_count * sizeof(uint32_t));
@@ -596,6 +630,7 @@ static unsigned char* init_state(sp_meshlet_context* ctx, skin_state* s)
     s->influences = sp_meshlet_carve(&cursor, v_count);
     s->open_band = 0;
     s->open_border = 0;
+    memset(s->border, 0, sizeof(s->border));
     sp_meshlet_plan_init(&s->plan, &cursor, t_count);
     memset(s->emitted, 0, t_count);
     build_adjacency(ctx, s);

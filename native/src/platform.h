@@ -37,6 +37,22 @@
 #define SP_PREFETCH(p) ((void)0)
 #endif
 
+/* Index of the lowest set bit of x, which is not 0. */
+#if defined(__GNUC__) || defined(__clang__)
+static inline unsigned sp_lowest_bit64(uint64_t x)
+{
+    return (unsigned)__builtin_ctzll(x);
+}
+#else
+static inline unsigned sp_lowest_bit64(uint64_t x)
+{
+    unsigned n = 0;
+    for (; !(x & 1); x >>= 1)
+        ++n;
+    return n;
+}
+#endif
+
 /* From here to the end of the file, every product and sum rounds on its own: the vector paths
  * must round as the scalar code does, and with FMA enabled both compilers would fuse some (GCC's
  * gnu11 default contracts across statements). Explicit FMA intrinsics stay where they are exact

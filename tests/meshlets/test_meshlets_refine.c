@@ -15,6 +15,9 @@
  * the plan; moving it and then triangle 11 from B to A (B loses vertex 1, A gains vertex 11,
  * which carries joint 1) gives A = {1}, B = {1, 2} with 8 vertices each: 3 entries. Exchange must
  * find that; with a triangle limit of 6 (B cannot take a seventh) it must leave the plan.
+ *
+ * Also the skin builder's sort of triangles by Morton code (sp_meshlet_sort_high_words): the same
+ * order as qsort of the whole keys, whose low words (triangle numbers) ascend.
  */
 #include "meshlets_internal.h"
 #include "test_expect.h"
@@ -164,8 +167,32 @@ static uint32_t exchange_ring(uint32_t max_triangles, int* changed)
     return sum;
 }
 
+/* Keys with many equal high words (codes under `spread`), low words ascending, against qsort. */
+static int sort_matches_qsort(size_t count, uint32_t spread)
+{
+    uint64_t* keys = malloc(count * sizeof(uint64_t) + 1);
+    uint64_t* temp = malloc(count * sizeof(uint64_t) + 1);
+    uint64_t* expected = malloc(count * sizeof(uint64_t) + 1);
+    uint32_t state = 12345;
+    for (size_t i = 0; i < count; ++i) {
+        state = state * 1664525u + 1013904223u;
+        expected[i] = keys[i] = (uint64_t)(state % spread) << 32 | i;
+    }
+    qsort(expected, count, sizeof(uint64_t), sp_meshlet_compare_u64);
+    sp_meshlet_sort_high_words(keys, temp, count);
+    int same = memcmp(keys, expected, count * sizeof(uint64_t)) == 0;
+    free(keys);
+    free(temp);
+    free(expected);
+    return same;
+}
+
 int main(void)
 {
+    EXPECT(sort_matches_qsort(0, 1) && sort_matches_qsort(1, 1), "sort: empty or single key");
+    EXPECT(sort_matches_qsort(5000, 7), "sort: 5000 keys, 7 codes");
+    EXPECT(sort_matches_qsort(100000, 1u << 30), "sort: 100000 keys, 30-bit codes");
+    EXPECT(sort_matches_qsort(3000, UINT32_MAX), "sort: 3000 keys, 32-bit codes");
     uint32_t a = 0, b = 0;
     /* A has vertices 0..7, B 6..13 (8 each); B takes triangle 5 only with room for vertex 5 */
     uint32_t owner = refine_strip(9, &a, &b);

@@ -443,6 +443,73 @@ static void test_skin_builder_quality(void)
     free_mesh(&grid);
 }
 
+/* The grid with every other quad split along its other diagonal: vertices in 4 or 8 triangles,
+ * so the skin builder treats it as irregular (distance tie-break, no rings). */
+static mesh checker_diagonals(const mesh* src, int side)
+{
+    mesh m = *src;
+    m.indices = malloc(m.index_count * sizeof(uint32_t));
+    m.positions = malloc(m.vertex_count * 3 * sizeof(float));
+    m.joints = malloc(m.vertex_count * K * sizeof(uint16_t));
+    m.weights = malloc(m.vertex_count * K * sizeof(float));
+    memcpy(m.positions, src->positions, m.vertex_count * 3 * sizeof(float));
+    memcpy(m.joints, src->joints, m.vertex_count * K * sizeof(uint16_t));
+    memcpy(m.weights, src->weights, m.vertex_count * K * sizeof(float));
+    size_t i = 0;
+    for (int y = 0; y + 1 < side; ++y)
+        for (int x = 0; x + 1 < side; ++x) {
+            uint32_t a = (uint32_t)(y * side + x), b = a + 1, c = a + (uint32_t)side, d = c + 1;
+            uint32_t quad[2][6] = {{a, b, d, a, d, c}, {a, b, c, b, d, c}};
+            memcpy(m.indices + i, quad[(x + y) & 1], sizeof(quad[0]));
+            i += 6;
+        }
+    return m;
+}
+
+static uint64_t fnv1a(uint64_t hash, const void* data, size_t bytes)
+{
+    const unsigned char* p = data;
+    for (size_t i = 0; i < bytes; ++i)
+        hash = (hash ^ p[i]) * 1099511628211ull;
+    return hash;
+}
+
+/* Golden splits: the skin builder's meshlet of every triangle and every palette, hashed, on a
+ * regular and an irregular grid. The search's shortcuts (only border vertices scanned, each
+ * candidate ranked once, far candidates skipped before their joints are counted) must not
+ * change a split; these hashes were taken with the builder before them and change only when the
+ * builder's choices do (then docs/benchmarks-meshlets.md is re-measured too). x86-64 only: on
+ * other targets the compiler may fuse the distance arithmetic, which moves ties. */
+static void test_skin_golden_splits(void)
+{
+#if defined(__x86_64__) || defined(_M_X64)
+    mesh grid = make_grid(48);
+    mesh regular = shuffled_copy(&grid, 11);
+    mesh irregular = checker_diagonals(&grid, 48);
+    const struct {
+        const mesh* mesh;
+        const char* name;
+        size_t meshlets;
+        uint64_t hash;
+    } cases[] = {{&regular, "regular", 47, 0x08cee2d13db76779ull}, {&irregular, "irregular", 46, 0x6c2ab22763f819d1ull}};
+    for (size_t c = 0; c < sizeof(cases) / sizeof(cases[0]); ++c) {
+        meshlet_input in = input_of(cases[c].mesh);
+        sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
+        meshlet_run run;
+        EXPECT(meshlet_run_build(&run, &in, &o) == SP_OK, "golden %s: build failed", cases[c].name);
+        uint64_t hash = fnv1a(14695981039346656037ull, run.out.triangle_meshlet, in.index_count / 3 * sizeof(uint32_t));
+        hash = fnv1a(hash, run.out.joints, run.stats.joint_count * sizeof(uint16_t));
+        EXPECT(run.stats.meshlet_count == cases[c].meshlets && hash == cases[c].hash,
+               "golden %s: %zu meshlets, split %016llx (%zu, %016llx)", cases[c].name, run.stats.meshlet_count,
+               (unsigned long long)hash, cases[c].meshlets, (unsigned long long)cases[c].hash);
+        meshlet_run_free(&run);
+    }
+    free_mesh(&irregular);
+    free_mesh(&regular);
+    free_mesh(&grid);
+#endif
+}
+
 static void test_degenerate_triangles(void)
 {
     mesh grid = make_grid(12);
@@ -848,6 +915,7 @@ int main(void)
     test_skin_band_grid();
     test_skin_seed_front();
     test_skin_anisotropic_grid();
+    test_skin_golden_splits();
     test_degenerate_triangles();
     test_palette_limit_error();
     test_joint_lower_bound();
