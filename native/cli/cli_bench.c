@@ -276,11 +276,15 @@ static void time_row(const bench_options* o, bench_buffers* b, bench_row* row, i
 
 /* Every row's repetitions, as rounds: each round times every row once. A neighbour's burst on
  * the shared machine (seconds long) then slows one repetition of many rows instead of every
- * repetition of a few, so each row's best-of figures come from moments spread over the run. */
+ * repetition of a few, so each row's best-of figures come from moments spread over the run.
+ * The rows are known only after the last round, so the text output says on stderr how far the
+ * rounds are. */
 static void time_rows(const bench_options* o, bench_buffers* b, bench_row* rows, size_t count)
 {
-    for (int r = 0; r < o->repeats; ++r)
+    for (int r = 0; r < o->repeats; ++r) {
         for (size_t i = 0; i < count; ++i) time_row(o, b, &rows[i], r);
+        if (!o->json) fprintf(stderr, "skinpack bench: round %d of %d done\n", r + 1, o->repeats);
+    }
 }
 
 /* The run's header: the machine's rates as a JSON object's head, or as text lines. */
@@ -342,8 +346,9 @@ int skinpack_cmd_bench(int argc, char** argv)
     bench_rate lut = lut_rate(&o, &b, &lut_size);
     narrow(&o, &b);
     size_t row_count = make_rows(rows);
-    time_rows(&o, &b, rows, row_count);
     print_header(&o, isa, cpu, copy, lut, lut_size);
+    fflush(stdout); /* the header before the rounds, also through a pipe */
+    time_rows(&o, &b, rows, row_count);
     for (size_t i = 0; i < row_count; ++i) {
         const sp_codec* codec = &rows[i].codec;
         int vector = codec->method == SP_METHOD_OSS && sp_oss_batch_supported(codec, isa);
