@@ -494,9 +494,24 @@ static uint32_t border_vertices(const sp_meshlet_context* ctx, const skin_state*
     return count;
 }
 
+/* Whether a candidate cannot beat best whatever joints and tuples it adds: they only raise its
+ * cost (at least cost_without_joints), its rank (at least its ring, the new joints ranking
+ * above it) and its distance (at least near). Equal distances go to the lower triangle index,
+ * so they are not decided here. */
+static int cannot_win(const candidate* best, float cost_without_joints, uint32_t ring, float near)
+{
+    if (cost_without_joints != best->cost)
+        return cost_without_joints > best->cost;
+    if (ring != best->rank)
+        return ring > best->rank;
+    return near > best->distance;
+}
+
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
- * limit. The joint and tuple terms are never negative, so a candidate whose topology alone is
- * worse than the best so far is skipped before they are counted. */
+ * limit. Only the border's vertices have live triangles, and a triangle at two or three of them
+ * is ranked once. The joint and tuple terms are never negative, so a candidate whose topology
+ * alone is worse than the best so far, or that cannot win without them (cannot_win), is skipped
+ * before they are counted; none of this changes which triangle wins. */
 static candidate best_neighbour(const sp_meshlet_context* ctx, skin_state* s, int require_fit)
 {
     candidate best = {NO_TRIANGLE, 0.0f, 0, 0.0f};
@@ -534,24 +549,27 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, skin_state* s, in
             float priority = topology_priority(s, tri, new_vertices);
             if (best.triangle != NO_TRIANGLE && priority > best.cost)
                 continue;
-            /* without ranks (irregular mesh), one of the best's priority that lies farther cannot
-             * win: its other terms only add to its cost and scale its distance up */
-            float near = distance_to(s, t, point);
-            if (!s->regular && best.triangle != NO_TRIANGLE && priority == best.cost && near > best.distance)
+            float band = 0.0f, near = distance_to(s, t, point);
+            uint32_t ring = 0; /* irregular meshes rank no rings */
+            if (s->regular) {
+                band = band_cost > 0.0f && new_vertices > 0 && below_band(s, tri) ? band_cost : 0.0f;
+                ring = inner_ring(ctx, s, tri);
+            }
+            if (best.triangle != NO_TRIANGLE && cannot_win(&best, priority + band, ring, near))
                 continue;
             uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
             if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
                 continue;
             float cost = priority + joint_cost * (float)new_joints;
-            if (band_cost > 0.0f && new_vertices > 0 && below_band(s, tri))
-                cost += band_cost;
+            if (band > 0.0f)
+                cost += band;
             if (ctx->options.tuple_cost > 0.0f)
                 cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
             if (best.triangle != NO_TRIANGLE && cost > best.cost)
                 continue;
             /* among equal costs a candidate that widens the palette counts as farther */
             float distance = near * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
-            candidate c = {t, cost, s->regular ? new_joints << 16 | inner_ring(ctx, s, tri) : 0, distance};
+            candidate c = {t, cost, s->regular ? new_joints << 16 | ring : 0, distance};
             if (cost == 0.0f)
                 return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
                            * such triangles join does not change the meshlet */
