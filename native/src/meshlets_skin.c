@@ -507,28 +507,82 @@ static int cannot_win(const candidate* best, float cost_without_joints, uint32_t
     return near > best->distance;
 }
 
+/* What a search ranks candidates with: the open meshlet's centre and the costs of a new joint
+ * and of a triangle below the meshlet's band at this point of its growth. */
+typedef struct search_terms {
+    float point[3];
+    float joint_cost, band_cost;
+    int require_fit;
+} search_terms;
+
+static search_terms search_terms_now(const sp_meshlet_context* ctx, const skin_state* s, int require_fit)
+{
+    search_terms terms;
+    open_centroid(ctx, s, terms.point);
+    terms.require_fit = require_fit;
+    /* on a regular mesh, while the meshlet is compact, a new joint costs REGULAR_JOINT_COST and a
+     * triangle below its band REGULAR_BAND_COST (see the top); in the meshlet's last vertices a
+     * new joint also costs LATE_JOINT_COST */
+    terms.joint_cost = ctx->options.joint_cost;
+    terms.band_cost = 0.0f;
+    if (s->regular && compact_meshlet(ctx, s)) {
+        terms.joint_cost += REGULAR_JOINT_COST;
+        terms.band_cost = s->banded ? REGULAR_BAND_COST : 0.0f;
+    }
+    if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
+        terms.joint_cost += LATE_JOINT_COST;
+    return terms;
+}
+
+/* Ranks live triangle t against best; returns the better one. A triangle that adds no vertex
+ * is returned with cost 0: nothing beats it. The joint and tuple terms are never negative, so a
+ * candidate whose topology alone is worse than the best so far, or that cannot win without them
+ * (cannot_win), is dropped before they are counted; that changes no result. */
+static candidate rank_candidate(const sp_meshlet_context* ctx, const skin_state* s, const search_terms* terms,
+                                uint32_t t, candidate best)
+{
+    const uint32_t* tri = ctx->indices + (size_t)t * 3;
+    uint32_t new_vertices = sp_meshlet_new_vertices(ctx, t);
+    if (terms->require_fit && ctx->open_vertex_count + new_vertices > ctx->options.max_vertices)
+        return best;
+    float priority = topology_priority(s, tri, new_vertices);
+    if (best.triangle != NO_TRIANGLE && priority > best.cost)
+        return best;
+    float band = 0.0f, near = distance_to(s, t, terms->point);
+    uint32_t ring = 0; /* irregular meshes rank no rings */
+    if (s->regular) {
+        band = terms->band_cost > 0.0f && new_vertices > 0 && below_band(s, tri) ? terms->band_cost : 0.0f;
+        ring = inner_ring(ctx, s, tri);
+    }
+    if (best.triangle != NO_TRIANGLE && cannot_win(&best, priority + band, ring, near))
+        return best;
+    uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
+    if (terms->require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
+        return best;
+    float cost = priority + terms->joint_cost * (float)new_joints;
+    if (band > 0.0f)
+        cost += band;
+    if (ctx->options.tuple_cost > 0.0f)
+        cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
+    if (best.triangle != NO_TRIANGLE && cost > best.cost)
+        return best;
+    /* among equal costs a candidate that widens the palette counts as farther */
+    float distance = near * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
+    candidate c = {t, cost, s->regular ? new_joints << 16 | ring : 0, distance};
+    /* one that adds no vertex (hence no joint) wins at once: the order in which such triangles
+     * join does not change the meshlet */
+    return cost == 0.0f || better(&c, &best) ? c : best;
+}
+
 /* Best live triangle next to the open meshlet; with require_fit only those that fit every
  * limit. Only the border's vertices have live triangles, and a triangle at two or three of them
- * is ranked once. The joint and tuple terms are never negative, so a candidate whose topology
- * alone is worse than the best so far, or that cannot win without them (cannot_win), is skipped
- * before they are counted; none of this changes which triangle wins. */
+ * is ranked once. */
 static candidate best_neighbour(const sp_meshlet_context* ctx, skin_state* s, int require_fit)
 {
     candidate best = {NO_TRIANGLE, 0.0f, 0, 0.0f};
     if (require_fit && ctx->open_triangle_count >= ctx->options.max_triangles)
         return best;
-    float point[3];
-    open_centroid(ctx, s, point);
-    /* on a regular mesh, while the meshlet is compact, a new joint costs REGULAR_JOINT_COST and a
-     * triangle below its band REGULAR_BAND_COST (see the top); in the meshlet's last vertices a
-     * new joint also costs LATE_JOINT_COST */
-    float joint_cost = ctx->options.joint_cost, band_cost = 0.0f;
-    if (s->regular && compact_meshlet(ctx, s)) {
-        joint_cost += REGULAR_JOINT_COST;
-        band_cost = s->banded ? REGULAR_BAND_COST : 0.0f;
-    }
-    if (ctx->open_vertex_count + ctx->options.max_vertices / LATE_VERTICES_DIVISOR >= ctx->options.max_vertices)
-        joint_cost += LATE_JOINT_COST;
+    search_terms terms = search_terms_now(ctx, s, require_fit);
     if (++s->search == 0) { /* the numbers wrapped: forget the old ones */
         memset(s->seen, 0, ctx->triangle_count * sizeof(uint32_t));
         s->search = 1;
@@ -542,39 +596,9 @@ static candidate best_neighbour(const sp_meshlet_context* ctx, skin_state* s, in
             if (s->seen[t] == s->search)
                 continue; /* ranked already from another of its corners */
             s->seen[t] = s->search;
-            const uint32_t* tri = ctx->indices + (size_t)t * 3;
-            uint32_t new_vertices = sp_meshlet_new_vertices(ctx, t);
-            if (require_fit && ctx->open_vertex_count + new_vertices > ctx->options.max_vertices)
-                continue;
-            float priority = topology_priority(s, tri, new_vertices);
-            if (best.triangle != NO_TRIANGLE && priority > best.cost)
-                continue;
-            float band = 0.0f, near = distance_to(s, t, point);
-            uint32_t ring = 0; /* irregular meshes rank no rings */
-            if (s->regular) {
-                band = band_cost > 0.0f && new_vertices > 0 && below_band(s, tri) ? band_cost : 0.0f;
-                ring = inner_ring(ctx, s, tri);
-            }
-            if (best.triangle != NO_TRIANGLE && cannot_win(&best, priority + band, ring, near))
-                continue;
-            uint32_t new_joints = sp_meshlet_new_joints(ctx, t);
-            if (require_fit && ctx->open_joint_count + new_joints > ctx->options.max_joints)
-                continue;
-            float cost = priority + joint_cost * (float)new_joints;
-            if (band > 0.0f)
-                cost += band;
-            if (ctx->options.tuple_cost > 0.0f)
-                cost += ctx->options.tuple_cost * (float)new_tuples(ctx, s, t);
-            if (best.triangle != NO_TRIANGLE && cost > best.cost)
-                continue;
-            /* among equal costs a candidate that widens the palette counts as farther */
-            float distance = near * (1.0f + JOINT_DISTANCE_FACTOR * (float)new_joints);
-            candidate c = {t, cost, s->regular ? new_joints << 16 | ring : 0, distance};
-            if (cost == 0.0f)
-                return c; /* adds no vertex, hence no joint: nothing beats it, and the order in which
-                           * such triangles join does not change the meshlet */
-            if (better(&c, &best))
-                best = c;
+            best = rank_candidate(ctx, s, &terms, t, best);
+            if (best.triangle != NO_TRIANGLE && best.cost == 0.0f)
+                return best;
         }
     }
     return best;
