@@ -3,6 +3,7 @@
  * run under ASan/UBSan): every builder's output is checked in full by meshlet_check, plus the
  * thesis baselines' defining behaviour, determinism, the palette-limit error and bad arguments.
  */
+#include "../unit/fnv1a.h"
 #include "joint_bound.h"
 #include "meshlet_check.h"
 #include "test_expect.h"
@@ -466,14 +467,6 @@ static mesh checker_diagonals(const mesh* src, int side)
     return m;
 }
 
-static uint64_t fnv1a(uint64_t hash, const void* data, size_t bytes)
-{
-    const unsigned char* p = data;
-    for (size_t i = 0; i < bytes; ++i)
-        hash = (hash ^ p[i]) * 1099511628211ull;
-    return hash;
-}
-
 /* Golden splits: the skin builder's meshlet of every triangle and every palette, hashed, on a
  * regular and an irregular grid. The search's shortcuts (only border vertices scanned, each
  * candidate ranked once, far candidates skipped before their joints are counted) must not
@@ -497,7 +490,7 @@ static void test_skin_golden_splits(void)
         sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
         meshlet_run run;
         EXPECT(meshlet_run_build(&run, &in, &o) == SP_OK, "golden %s: build failed", cases[c].name);
-        uint64_t hash = fnv1a(14695981039346656037ull, run.out.triangle_meshlet, in.index_count / 3 * sizeof(uint32_t));
+        uint64_t hash = fnv1a(FNV1A_OFFSET, run.out.triangle_meshlet, in.index_count / 3 * sizeof(uint32_t));
         hash = fnv1a(hash, run.out.joints, run.stats.joint_count * sizeof(uint16_t));
         EXPECT(run.stats.meshlet_count == cases[c].meshlets && hash == cases[c].hash,
                "golden %s: %zu meshlets, split %016llx (%zu, %016llx)", cases[c].name, run.stats.meshlet_count,

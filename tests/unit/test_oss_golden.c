@@ -12,6 +12,7 @@
 
 #include "../../native/src/codec_internal.h" /* the *_isa batch forms */
 #include "check.h"
+#include "fnv1a.h"
 #include "skinpack.h"
 
 #define VERTICES 20000
@@ -24,13 +25,6 @@ static uint64_t next_random(void)
     rng_state ^= rng_state >> 7;
     rng_state ^= rng_state << 17;
     return rng_state;
-}
-
-static uint64_t fnv(uint64_t hash, const void* data, size_t size)
-{
-    const unsigned char* bytes = data;
-    for (size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 0x100000001b3ull;
-    return hash;
 }
 
 /* Sorted weights with 1..K non-zero slots; every 16th vertex ties (equal weights, where the
@@ -73,16 +67,16 @@ static void checksums(const sp_codec* codec, const float* weights, sp_isa isa, g
     uint8_t* significant = malloc(VERTICES);
     float* decoded = malloc(SAMPLED_CODES * k * sizeof(float));
     CHECK(sp_encode_weights_batch_isa(codec, weights, VERTICES, codes, significant, isa) == SP_OK);
-    out->encode = fnv(fnv(14695981039346656037ull, codes, VERTICES * sizeof(uint64_t)), significant, VERTICES);
+    out->encode = fnv1a(fnv1a(FNV1A_OFFSET, codes, VERTICES * sizeof(uint64_t)), significant, VERTICES);
     CHECK(sp_decode_weights_batch_isa(codec, codes, VERTICES, decoded, NULL, isa) == SP_OK);
-    out->decode = fnv(14695981039346656037ull, decoded, VERTICES * k * sizeof(float));
+    out->decode = fnv1a(FNV1A_OFFSET, decoded, VERTICES * k * sizeof(float));
     /* codes spread over the whole range, its two ends included */
     rng_state = 0x9E3779B97F4A7C15ull ^ codec->n;
     for (size_t i = 0; i < SAMPLED_CODES; ++i)
         codes[i] = i == 0 ? 0 : i == 1 ? codec->max_code
                  : codec->max_code == UINT64_MAX ? next_random() : next_random() % (codec->max_code + 1);
     CHECK(sp_decode_weights_batch_isa(codec, codes, SAMPLED_CODES, decoded, NULL, isa) == SP_OK);
-    out->sampled = fnv(14695981039346656037ull, decoded, SAMPLED_CODES * k * sizeof(float));
+    out->sampled = fnv1a(FNV1A_OFFSET, decoded, SAMPLED_CODES * k * sizeof(float));
     free(codes), free(significant), free(decoded);
 }
 
@@ -147,7 +141,7 @@ static void odd_checks(int print, float* weights)
                 make_odd_weights(k, weights);
                 for (size_t p = 0; p < (print ? 1 : sizeof(paths) / sizeof(paths[0])); ++p) {
                     CHECK(sp_encode_weights_batch_isa(&codec, weights, VERTICES, codes, significant, paths[p]) == SP_OK);
-                    uint64_t hash = fnv(fnv(14695981039346656037ull, codes, VERTICES * sizeof(uint64_t)), significant,
+                    uint64_t hash = fnv1a(fnv1a(FNV1A_OFFSET, codes, VERTICES * sizeof(uint64_t)), significant,
                                         VERTICES);
                     if (print) {
                         printf("{%d, %u, %u, 0x%016llxull},\n", m, k, budgets[b], (unsigned long long)hash);
