@@ -18,6 +18,7 @@
  * joints a short sequence can take out of a palette) that B already has.
  */
 #include "meshlets_internal.h"
+#include "platform.h"
 
 #include <string.h>
 
@@ -46,6 +47,11 @@ typedef struct pair {
     uint16_t vertex_refs[2][PAIR_VERTICES], joint_refs[2][PAIR_JOINTS];
     uint32_t count, vertex_count, joint_count;
     uint32_t vertices[2], joints[2], triangles[2]; /* per side */
+    /* a sequence's candidates: the triangles around each local vertex, and a bit per triangle
+     * that may be on the border (every border triangle's bit is set) */
+    uint16_t incidence_offset[PAIR_VERTICES + 1];
+    uint16_t incidence[3 * PAIR_TRIANGLES];
+    uint64_t candidate[PAIR_TRIANGLES / 64];
 } pair;
 
 /* Local id of vertex v (registered with its used joints on first sight), or -1 when the pair
@@ -242,26 +248,66 @@ static move_change change_of_move(const pair* p, uint32_t i)
     return change;
 }
 
+/* The triangles around each local vertex of the loaded pair (incidence lists, in triangle
+ * order), and the candidate bits of the triangles on the border between its sides. */
+static void find_candidates(pair* p)
+{
+    memset(p->incidence_offset, 0, (p->vertex_count + 1) * sizeof(uint16_t));
+    for (uint32_t i = 0; i < p->count; ++i)
+        for (int c = 0; c < 3; ++c)
+            if (p->corner[i][c] != NO_CORNER)
+                p->incidence_offset[p->corner[i][c] + 1]++;
+    for (uint32_t v = 0; v < p->vertex_count; ++v)
+        p->incidence_offset[v + 1] = (uint16_t)(p->incidence_offset[v + 1] + p->incidence_offset[v]);
+    uint16_t fill[PAIR_VERTICES];
+    memcpy(fill, p->incidence_offset, p->vertex_count * sizeof(uint16_t));
+    memset(p->candidate, 0, sizeof(p->candidate));
+    for (uint32_t i = 0; i < p->count; ++i) {
+        for (int c = 0; c < 3; ++c)
+            if (p->corner[i][c] != NO_CORNER)
+                p->incidence[fill[p->corner[i][c]]++] = (uint16_t)i;
+        if (on_border(p, i))
+            p->candidate[i / 64] |= 1ull << (i % 64);
+    }
+}
+
+/* After triangle i moved: only a triangle that shares a vertex with it can have come onto the
+ * border (its vertices' references are the only ones that changed). */
+static void add_candidates_around(pair* p, uint32_t i)
+{
+    for (int c = 0; c < 3; ++c) {
+        uint16_t v = p->corner[i][c];
+        if (v == NO_CORNER)
+            continue;
+        for (uint32_t k = p->incidence_offset[v]; k < p->incidence_offset[v + 1]; ++k)
+            p->candidate[p->incidence[k] / 64] |= 1ull << (p->incidence[k] % 64);
+    }
+}
+
 /* The unlocked border triangle whose move leaves the lowest (palette sum, vertex sum), within
- * the triangle limit, the palette cap and the vertex limit plus slack; NO_TRIANGLE if none. */
+ * the triangle limit, the palette cap and the vertex limit plus slack; NO_TRIANGLE if none.
+ * Candidates are visited in triangle order, so ties go to the lowest, as a full scan would. */
 static uint32_t best_move(const sp_meshlet_context* ctx, const pair* p)
 {
     uint32_t best = NO_TRIANGLE, best_joints = UINT32_MAX, best_vertices = UINT32_MAX;
-    for (uint32_t i = 0; i < p->count; ++i) {
-        int to = !p->side[i];
-        if (p->locked[i] || p->triangles[to] >= ctx->options.max_triangles || p->triangles[!to] == 1 || !on_border(p, i))
-            continue;
-        move_change change = change_of_move(p, i);
-        uint32_t joints = p->joints[0] + p->joints[1] + change.added_joints - change.removed_joints;
-        uint32_t vertices = p->vertices[0] + p->vertices[1] + change.added_vertices - change.removed_vertices;
-        int fits = p->joints[to] + change.added_joints <= ctx->options.max_joints &&
-                   p->vertices[to] + change.added_vertices <= ctx->options.max_vertices + EXCHANGE_VERTEX_SLACK;
-        if (fits && (joints < best_joints || (joints == best_joints && vertices < best_vertices))) {
-            best = i;
-            best_joints = joints;
-            best_vertices = vertices;
+    for (uint32_t word = 0; word * 64 < p->count; ++word)
+        for (uint64_t bits = p->candidate[word]; bits; bits &= bits - 1) {
+            uint32_t i = word * 64 + sp_lowest_bit64(bits);
+            int to = !p->side[i];
+            if (p->locked[i] || p->triangles[to] >= ctx->options.max_triangles || p->triangles[!to] == 1 ||
+                !on_border(p, i))
+                continue;
+            move_change change = change_of_move(p, i);
+            uint32_t joints = p->joints[0] + p->joints[1] + change.added_joints - change.removed_joints;
+            uint32_t vertices = p->vertices[0] + p->vertices[1] + change.added_vertices - change.removed_vertices;
+            int fits = p->joints[to] + change.added_joints <= ctx->options.max_joints &&
+                       p->vertices[to] + change.added_vertices <= ctx->options.max_vertices + EXCHANGE_VERTEX_SLACK;
+            if (fits && (joints < best_joints || (joints == best_joints && vertices < best_vertices))) {
+                best = i;
+                best_joints = joints;
+                best_vertices = vertices;
+            }
         }
-    }
     return best;
 }
 
@@ -271,12 +317,15 @@ static int exchange_pair(const sp_meshlet_context* ctx, sp_meshlet_plan* plan, p
 {
     uint32_t moved[EXCHANGE_STEPS], steps = 0, keep = 0;
     uint32_t best_joints = p->joints[0] + p->joints[1], best_vertices = p->vertices[0] + p->vertices[1];
+    find_candidates(p);
     while (steps < EXCHANGE_STEPS) {
         uint32_t i = best_move(ctx, p);
         if (i == NO_TRIANGLE)
             break;
         move(p, i);
         p->locked[i] = 1;
+        p->candidate[i / 64] &= ~(1ull << (i % 64));
+        add_candidates_around(p, i);
         moved[steps++] = i;
         uint32_t joints = p->joints[0] + p->joints[1], vertices = p->vertices[0] + p->vertices[1];
         if (within_limits(ctx, p) && (joints < best_joints || (joints == best_joints && vertices < best_vertices))) {

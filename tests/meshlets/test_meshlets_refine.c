@@ -14,7 +14,8 @@
  * a limit of 8. Triangle 5 alone cannot go to B (B has no room for vertex 5), so refine leaves
  * the plan; moving it and then triangle 11 from B to A (B loses vertex 1, A gains vertex 11,
  * which carries joint 1) gives A = {1}, B = {1, 2} with 8 vertices each: 3 entries. Exchange must
- * find that; with a triangle limit of 6 (B cannot take a seventh) it must leave the plan.
+ * find that; with a triangle limit of 6 (B cannot take a seventh) it must leave the plan. And on
+ * the strip, a sequence that needs triangles which reach the border only during it (below).
  *
  * Also the skin builder's sort of triangles by Morton code (sp_meshlet_sort_high_words): the same
  * order as qsort of the whole keys, whose low words (triangle numbers) ascend.
@@ -131,14 +132,11 @@ static uint32_t refine_strip(uint32_t max_vertices, uint32_t* size_a, uint32_t* 
     return owner;
 }
 
-/* Builds the ring plan with this triangle limit and runs refine and exchange; returns the
- * palette sum and checks every limit and that every triangle is in A or B. */
-static uint32_t exchange_ring(uint32_t max_triangles, int* changed)
+/* Runs exchange on the plan; returns the palette sum and checks every limit, that every
+ * triangle is in A or B and that the scratch it borrowed is left clean. */
+static uint32_t exchange_sum(fixture* f, int* changed)
 {
-    fixture* f = malloc(sizeof(fixture));
-    make_plan(f, 1, 7, 10, 8, max_triangles);
-    sp_meshlet_plan_refine(&f->ctx, &f->plan, f->offset, f->adjacency);
-    EXPECT(f->plan.owner[5] == 0 && f->plan.owner[11] == 1, "refine alone moves nothing on the ring");
+    uint32_t max_vertices = f->ctx.options.max_vertices, max_triangles = f->ctx.options.max_triangles;
     sp_meshlet_plan_exchange(&f->ctx, &f->plan, f->offset, f->adjacency, f->live);
     uint32_t sum = 0;
     *changed = 0;
@@ -151,17 +149,45 @@ static uint32_t exchange_ring(uint32_t max_triangles, int* changed)
             triangles++;
         }
         measure(f, g, &vertices, &joints);
-        EXPECT(vertices <= 8 && triangles <= max_triangles, "group %u: %u vertices, %u triangles", g, vertices,
-               triangles);
+        EXPECT(vertices <= max_vertices && triangles <= max_triangles, "group %u: %u vertices, %u triangles", g,
+               vertices, triangles);
         EXPECT(f->plan.triangle_count[g] == triangles, "group %u counts %u triangles, lists %u", g,
                f->plan.triangle_count[g], triangles);
         sum += joints;
     }
     EXPECT(f->plan.triangle_count[0] + f->plan.triangle_count[1] == TRIANGLES, "every triangle in A or B");
-    for (uint32_t v = 0; v < TRIANGLES; ++v)
+    for (uint32_t v = 0; v < f->ctx.vertex_count; ++v)
         EXPECT(f->live[v] == 0, "vertex_local of vertex %u left at %u", v, f->live[v]);
     for (uint32_t j = 0; j < 3; ++j)
         EXPECT(f->joint_slot[j] == SP_MESHLET_NO_SLOT, "joint slot %u left in use", j);
+    return sum;
+}
+
+/* The ring plan with this triangle limit: refine alone leaves it, exchange must not. */
+static uint32_t exchange_ring(uint32_t max_triangles, int* changed)
+{
+    fixture* f = malloc(sizeof(fixture));
+    make_plan(f, 1, 7, 10, 8, max_triangles);
+    sp_meshlet_plan_refine(&f->ctx, &f->plan, f->offset, f->adjacency);
+    EXPECT(f->plan.owner[5] == 0 && f->plan.owner[11] == 1, "refine alone moves nothing on the ring");
+    uint32_t sum = exchange_sum(f, changed);
+    free_plan(f);
+    free(f);
+    return sum;
+}
+
+/* The strip with joint 2 on vertices 4..11 (joint 1 on 0..3 and 12, 13): A = {1, 2}, B = {1, 2}.
+ * A drops joint 2 only when triangles 2..5 all go to B (A keeps vertices 0..3, B holds 2..13: 12
+ * vertices). Only 4 and 5 are on the border at first; 3 and 2 reach it as their neighbours move,
+ * so the sequence must take in triangles that came onto the border during it. Returns the
+ * palette sum and the owner of triangle 2. */
+static uint32_t exchange_deep_strip(uint32_t* owner_of_2)
+{
+    fixture* f = malloc(sizeof(fixture));
+    make_plan(f, 0, 4, 11, 12, 124);
+    int changed = 0;
+    uint32_t sum = exchange_sum(f, &changed);
+    *owner_of_2 = f->plan.owner[2];
     free_plan(f);
     free(f);
     return sum;
@@ -205,6 +231,8 @@ int main(void)
     EXPECT(sum == 3 && changed, "ring: palette sum %u after exchange (want 3)", sum);
     sum = exchange_ring(6, &changed);
     EXPECT(sum == 4 && !changed, "ring at 6 triangles: palette sum %u, changed %d (want 4, unchanged)", sum, changed);
+    sum = exchange_deep_strip(&owner);
+    EXPECT(sum == 3 && owner == 1, "deep strip: palette sum %u, triangle 2 in %u (want 3, in B)", sum, owner);
     if (failures) {
         fprintf(stderr, "test_meshlets_refine: %d failures\n", failures);
         return 1;
