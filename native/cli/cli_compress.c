@@ -73,13 +73,15 @@ static void compress_usage(FILE* out) {
             "  --meshlet-vertices N   meshlet vertex limit, 3..%d (default %u)\n"
             "  --meshlet-triangles N  meshlet triangle limit, 1..%d (default %u)\n"
             "  --meshlet-joints N     palette cap: joints a meshlet may use, 1..%d (default %u)\n"
+            "  --meshlet-effort N     random border moves tried per triangle for smaller palettes,\n"
+            "                         0..%d (default %u; the time grows with it, ~0.02 ms a triangle at 1000)\n"
             "  --meshopt            meshopt-compress the packed words and tuple table where that is smaller\n"
             "                       (EXT_meshopt_compression, required; KHR_ if the input uses it)\n"
             "  --exact-tuples       no don't-care sharing: zero-weight slots keep their joints\n"
             "  --json               machine-readable report on stdout\n"
             "IN and OUT are .gltf or .glb; OUT's kind follows its file name.\n",
             SP_MESHLET_MAX_VERTICES, defaults.max_vertices, SP_MESHLET_MAX_TRIANGLES, defaults.max_triangles,
-            SP_MESHLET_MAX_JOINTS, defaults.max_joints);
+            SP_MESHLET_MAX_JOINTS, defaults.max_joints, SP_MESHLET_MAX_PALETTE_EFFORT, defaults.palette_effort);
 }
 
 static int parse_uint(const char* s, unsigned long max, uint32_t* out) {
@@ -159,19 +161,21 @@ static int parse_budget(const char* a, const char* value, compress_args* args) {
     return 0;
 }
 
-/* --meshlet-vertices/-triangles/-joints: 1 if a is one of them (value consumed), 0 if not, -1
- * on a bad value. The ranges are the library's (sp_check_meshlet_options). */
+/* --meshlet-vertices/-triangles/-joints/-effort: 1 if a is one of them (value consumed), 0 if
+ * not, -1 on a bad value. The ranges are the library's (sp_check_meshlet_options). */
 static int parse_meshlet_limit(const char* a, const char* value, compress_args* args) {
     sp_meshlet_options* o = &args->meshlet_options;
     uint32_t* field = strcmp(a, "--meshlet-vertices") == 0    ? &o->max_vertices
                       : strcmp(a, "--meshlet-triangles") == 0 ? &o->max_triangles
                       : strcmp(a, "--meshlet-joints") == 0    ? &o->max_joints
+                      : strcmp(a, "--meshlet-effort") == 0    ? &o->palette_effort
                                                               : NULL;
     if (!field || !value) return 0;
     if (!args->meshlet_limit) args->meshlet_limit = a;
     if (parse_uint(value, UINT32_MAX, field) || sp_check_meshlet_options(o) != SP_OK) {
-        fprintf(stderr, "Error: %s %s: vertices must be 3..%d, triangles 1..%d, joints 1..%d\n", a, value,
-                SP_MESHLET_MAX_VERTICES, SP_MESHLET_MAX_TRIANGLES, SP_MESHLET_MAX_JOINTS);
+        fprintf(stderr, "Error: %s %s: vertices must be 3..%d, triangles 1..%d, joints 1..%d, effort 0..%d\n", a,
+                value, SP_MESHLET_MAX_VERTICES, SP_MESHLET_MAX_TRIANGLES, SP_MESHLET_MAX_JOINTS,
+                SP_MESHLET_MAX_PALETTE_EFFORT);
         return -1;
     }
     return 1;

@@ -504,6 +504,7 @@ SP_API size_t sp_format_validation(const sp_validation* report, char* buffer, si
 #define SP_MESHLET_MAX_TRIANGLES 512
 #define SP_MESHLET_MAX_JOINTS 255     /* palette indices are u8 */
 #define SP_MESHLET_TRIANGLE_JOINTS 12 /* a triangle carries at most 3 vertices x 4 joints */
+#define SP_MESHLET_MAX_PALETTE_EFFORT 10000 /* sp_meshlet_options.palette_effort */
 
 typedef enum sp_meshlet_builder {
     SP_MESHLETS_NAIVE = 0,  /* thesis listing A.1: greedy in index order */
@@ -520,6 +521,12 @@ typedef struct sp_meshlet_options {
     uint32_t min_group_triangles; /* SP_MESHLETS_COMMON: smaller groups go to the remainder; default 16 */
     float joint_cost;             /* SP_MESHLETS_SKIN: cost of one new palette joint in new vertices, 0..1000; default 0 */
     float tuple_cost;             /* SP_MESHLETS_SKIN: cost of one new local LUT tuple in new vertices, 0..1000; default 0 */
+    /* SP_MESHLETS_SKIN: extra work for smaller palettes, 0..SP_MESHLET_MAX_PALETTE_EFFORT; default 0
+     * (none). After the build, palette_effort x triangles random moves of a border triangle to a
+     * neighbouring meshlet are tried; one is kept when it passes no limit and adds no joint to
+     * that meshlet's palette. The palette sum and the meshlet count never rise; the time grows
+     * with the effort (docs/meshlets.md). The same input gives the same meshlets. */
+    uint32_t palette_effort;
 } sp_meshlet_options;
 
 /* Fills the defaults listed above. */

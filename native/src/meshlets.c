@@ -16,6 +16,7 @@ void sp_meshlet_options_default(sp_meshlet_options* options)
     options->min_group_triangles = 16;
     options->joint_cost = 0.0f;
     options->tuple_cost = 0.0f;
+    options->palette_effort = 0;
 }
 
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles)
@@ -30,12 +31,14 @@ static size_t stats_scratch_bound(size_t vertex_count)
     return sp_meshlet_tuple_set_slots(vertex_count) * sizeof(uint64_t);
 }
 
-static size_t builder_scratch_bound(uint32_t builder, size_t triangle_count, size_t vertex_count)
+static size_t builder_scratch_bound(const sp_meshlet_options* options, size_t triangle_count, size_t vertex_count)
 {
     size_t bytes = stats_scratch_bound(vertex_count);
+    uint32_t builder = options->builder;
     size_t own = builder == SP_MESHLETS_COMMON ? sp_meshlet_common_builder_scratch_bound(triangle_count)
-               : builder == SP_MESHLETS_SKIN   ? sp_meshlet_skin_builder_scratch_bound(triangle_count, vertex_count)
-                                               : 0;
+               : builder == SP_MESHLETS_SKIN
+                   ? sp_meshlet_skin_builder_scratch_bound(triangle_count, vertex_count, options->palette_effort > 0)
+                   : 0;
     return own > bytes ? own : bytes;
 }
 
@@ -61,7 +64,7 @@ void sp_meshlets_bound(size_t index_count, size_t vertex_count, size_t influence
     sizes->joints = triangle_count * 3 * influences;
     sizes->tuples = triangle_count * 3;
     sizes->scratch_bytes = sp_meshlet_common_scratch_bound(triangle_count, vertex_count, max_triangles) +
-                           builder_scratch_bound(options->builder, triangle_count, vertex_count);
+                           builder_scratch_bound(options, triangle_count, vertex_count);
 }
 
 sp_result sp_check_meshlet_options(const sp_meshlet_options* o)
@@ -71,7 +74,7 @@ sp_result sp_check_meshlet_options(const sp_meshlet_options* o)
     if (o->builder >= SP_MESHLETS_BUILDER_COUNT || o->max_vertices < 3 || o->max_vertices > SP_MESHLET_MAX_VERTICES ||
         o->max_triangles < 1 || o->max_triangles > SP_MESHLET_MAX_TRIANGLES || o->max_joints < 1 ||
         o->max_joints > SP_MESHLET_MAX_JOINTS || !(o->joint_cost >= 0.0f && o->joint_cost <= 1000.0f) ||
-        !(o->tuple_cost >= 0.0f && o->tuple_cost <= 1000.0f))
+        !(o->tuple_cost >= 0.0f && o->tuple_cost <= 1000.0f) || o->palette_effort > SP_MESHLET_MAX_PALETTE_EFFORT)
         return SP_ERR_INVALID_ARGUMENT;
     return SP_OK;
 }

@@ -65,7 +65,7 @@ static inline void* sp_meshlet_carve(unsigned char** cursor, size_t bytes)
 /* Scratch bytes the common part needs, and what each builder needs on top of it. */
 size_t sp_meshlet_common_scratch_bound(size_t triangle_count, size_t vertex_count, size_t max_triangles);
 size_t sp_meshlet_common_builder_scratch_bound(size_t triangle_count);
-size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count);
+size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count, int walk);
 
 /* Unique K-joint tuples over the mesh, with the same rule as the local LUTs (zero-weight slots
  * read as joint 0), in an open-addressing set of sp_meshlet_tuple_set_slots(vertex_count) u64s.
@@ -193,6 +193,12 @@ void sp_meshlet_plan_move_triangle(sp_meshlet_plan* plan, uint32_t t, uint32_t b
  * point within every limit (vertex_local: vertex_count zeros, left zero). */
 void sp_meshlet_plan_exchange(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
                               const uint32_t* vertex_adjacency, uint32_t* vertex_local);
+/* meshlets_walk.c: with options.palette_effort, random moves of border triangles between
+ * neighbouring groups of the linked plan, each kept when it passes no limit and adds no joint to
+ * the receiving group (scratch: sp_meshlet_walk_scratch_bound bytes). */
+size_t sp_meshlet_walk_scratch_bound(size_t triangle_count, size_t vertex_count);
+void sp_meshlet_plan_walk(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
+                          unsigned char* scratch);
 /* Writes every group of the linked plan as one meshlet. */
 void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
 

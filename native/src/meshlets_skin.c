@@ -94,7 +94,7 @@ typedef struct skin_state {
     uint16_t ring[SP_MESHLET_MAX_VERTICES]; /* per open vertex slot: edge hops from the meshlet's first vertices */
 } skin_state;
 
-size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count)
+size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t vertex_count, int walk)
 {
     size_t tuple_slots = sp_meshlet_tuple_set_slots(vertex_count);
     size_t per_vertex = sp_meshlet_align8((vertex_count + 1) * sizeof(uint32_t)) + /* adjacency_offset */
@@ -109,8 +109,10 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
                     sp_meshlet_align8(tuple_slots * sizeof(uint64_t));        /* the tuple set */
     size_t parts = sp_meshlet_parts_scratch_bound(triangle_count, vertex_count);
     size_t pack = sp_meshlet_pack_scratch_bound(triangle_count); /* after the parts step, in the same bytes */
+    size_t last = walk ? sp_meshlet_walk_scratch_bound(triangle_count, vertex_count) : 0; /* after both */
+    size_t shared = parts > pack ? parts : pack;
     return per_vertex + per_triangle + tuples + sp_meshlet_plan_scratch_bound(triangle_count) +
-           (parts > pack ? parts : pack);
+           (last > shared ? last : shared);
 }
 
 /* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
@@ -742,5 +744,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
     /* live as the exchange step's zeroed vertex scratch (the parts closed whole never left it) */
     memset(s.live, 0, ctx->vertex_count * sizeof(uint32_t));
     sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live);
+    if (ctx->options.palette_effort > 0) /* in the parts' and packing's bytes, free again */
+        sp_meshlet_plan_walk(ctx, &s.plan, s.adjacency_offset, cursor);
     sp_meshlet_plan_write(ctx, &s.plan);
 }

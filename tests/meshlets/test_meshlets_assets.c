@@ -2,8 +2,8 @@
  * test_meshlets_assets.c - every builder at several limits on real skinned meshes exported by
  * export_mesh_data.py (label "meshlets"): the full meshlet_check on each output (every meshlet
  * within every limit, the palette cap included), determinism of
- * each builder (at 64/124/32), the palette-limit error on a limit below the mesh's widest
- * triangle, and that no builder's split goes below the joint lower bound (joint_bound.h) that
+ * each builder (at 64/124/32), the skin builder with palette_effort, the palette-limit error on a
+ * limit below the mesh's widest triangle, and that no builder's split goes below the joint lower bound (joint_bound.h) that
  * the benchmark uses to judge the joints-per-meshlet target.
  *
  *   test_meshlets_assets FILE.spmd...
@@ -87,6 +87,32 @@ static int check_as_compressed(const char* path, mesh_data* mesh)
     return failures;
 }
 
+/* palette_effort on the skin builder at the benchmark's limits: the full check, the bound and
+ * determinism (check_split), and never more meshlets or palette entries than without it. The
+ * subdivided copies get a token effort: the walk gains nothing there and its time grows with
+ * the triangles (docs/meshlets.md). */
+static int check_palette_effort(const char* path, const meshlet_input* in)
+{
+    int failures = 0;
+    for (uint32_t cap = 16; cap <= 32; cap += 16) {
+        sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, cap);
+        meshlet_run base, walked;
+        meshlet_run_build(&base, in, &o);
+        o.palette_effort = in->index_count / 3 < 20000 ? 300 : 2;
+        failures += check_split(path, "effort ", in, o, 1);
+        meshlet_run_build(&walked, in, &o);
+        int kept = walked.result == SP_OK && walked.stats.meshlet_count <= base.stats.meshlet_count &&
+                   walked.stats.joint_count <= base.stats.joint_count;
+        printf("%s effort %u, cap %u: %zu meshlets / %zu palette entries (effort 0: %zu / %zu)%s\n", path,
+               o.palette_effort, cap, walked.stats.meshlet_count, walked.stats.joint_count, base.stats.meshlet_count,
+               base.stats.joint_count, kept ? "" : " MORE THAN WITHOUT");
+        failures += !kept;
+        meshlet_run_free(&walked);
+        meshlet_run_free(&base);
+    }
+    return failures;
+}
+
 static int check_file(const char* path)
 {
     mesh_data mesh;
@@ -103,6 +129,7 @@ static int check_file(const char* path)
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
         for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l)
             failures += check_split(path, "", &in, meshlet_options(b, limits[l][0], limits[l][1], limits[l][2]), l == 0);
+    failures += check_palette_effort(path, &in);
     failures += check_as_compressed(path, &mesh);
 
     /* the widest triangle: build one meshlet per triangle and take the largest palette */
