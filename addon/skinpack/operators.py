@@ -138,6 +138,7 @@ class SKINPACK_OT_preview_meshlets(bpy.types.Operator):
     max_vertices: properties.meshlet_limit_properties()["max_vertices"]
     max_triangles: properties.meshlet_limit_properties()["max_triangles"]
     palette_size: properties.meshlet_limit_properties()["palette_size"]
+    palette_effort: properties.meshlet_limit_properties()["palette_effort"]
 
     @classmethod
     def poll(cls, context):
@@ -154,7 +155,8 @@ class SKINPACK_OT_preview_meshlets(bpy.types.Operator):
             progress.step(0, "reading %s" % obj.name)
             inputs = meshlet_preview.read_inputs(obj, obj.data.skinpack.max_influences)
             progress.step(1, "building %s meshlets of %s" % (builder, obj.name))
-            options = native.meshlet_options(builder, self.max_vertices, self.max_triangles, self.palette_size)
+            options = native.meshlet_options(builder, self.max_vertices, self.max_triangles, self.palette_size,
+                                             self.palette_effort)
             meshlets = meshlet_preview.build(obj, inputs, options)
         except (gather.GatherError, native.SkinpackError) as error:
             self.report({'ERROR'}, str(error))

@@ -147,6 +147,7 @@ def _draw_meshlets(layout, context, obj):
     col.prop(settings, "max_vertices")
     col.prop(settings, "max_triangles")
     col.prop(settings, "palette_size")
+    col.prop(settings, "palette_effort")
     row = box.row(align=True)
     for mode, text, icon in (('MESHLET', "Meshlets", 'MESH_ICOSPHERE'), ('JOINTS', "Joints", 'BONE_DATA')):
         op = row.operator("skinpack.preview_meshlets", text=text, icon=icon)
@@ -155,6 +156,7 @@ def _draw_meshlets(layout, context, obj):
         op.max_vertices = settings.max_vertices
         op.max_triangles = settings.max_triangles
         op.palette_size = settings.palette_size
+        op.palette_effort = settings.palette_effort
     row.operator("skinpack.clear_preview", text="", icon='X')
     mode = meshlet_preview.shown_mode(obj.data)
     if mode is None or not settings.valid:

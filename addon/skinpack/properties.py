@@ -15,7 +15,8 @@ def _library_defaults():
     limits = native.CONSTANTS
     defaults = {"method": 'OSS', "budget": '32', "max_influences": limits["SP_MAX_INFLUENCES"],
                 "builder": 'SKIN', "max_vertices": limits["SP_MESHLET_MAX_VERTICES"],
-                "max_triangles": limits["SP_MESHLET_MAX_TRIANGLES"], "palette_size": limits["SP_MESHLET_MAX_JOINTS"]}
+                "max_triangles": limits["SP_MESHLET_MAX_TRIANGLES"], "palette_size": limits["SP_MESHLET_MAX_JOINTS"],
+                "palette_effort": 0}
     try:
         options, meshlets = native.default_options(), native.meshlet_options()
     except native.SkinpackError:
@@ -25,7 +26,7 @@ def _library_defaults():
                     budget=budget if budget in ('32', '48', '64') else 'CUSTOM',
                     builder=native.MESHLET_BUILDERS[meshlets.builder].upper(),
                     max_vertices=int(meshlets.max_vertices), max_triangles=int(meshlets.max_triangles),
-                    palette_size=int(meshlets.max_joints))
+                    palette_size=int(meshlets.max_joints), palette_effort=int(meshlets.palette_effort))
     return defaults
 
 
@@ -34,7 +35,8 @@ LIMITS = native.CONSTANTS
 
 
 def meshlet_limit_properties():
-    """The three meshlet limits as properties (the object's settings and the operator share them)."""
+    """The three meshlet limits and the palette effort as properties (the object's settings and the
+    operator share them)."""
     return {
         "max_vertices": IntProperty(name="Max Vertices", default=DEFAULTS["max_vertices"], min=1,
                                     max=LIMITS["SP_MESHLET_MAX_VERTICES"],
@@ -44,6 +46,11 @@ def meshlet_limit_properties():
         "palette_size": IntProperty(name="Palette Size", default=DEFAULTS["palette_size"], min=1,
                                     max=LIMITS["SP_MESHLET_MAX_JOINTS"],
                                     description="Distinct joints per meshlet (the joint palette limit)"),
+        "palette_effort": IntProperty(name="Palette Effort", default=DEFAULTS["palette_effort"], min=0,
+                                      max=LIMITS["SP_MESHLET_MAX_PALETTE_EFFORT"],
+                                      description="Skin-Aware builder: random border moves tried per triangle after "
+                                                  "the build for smaller palettes (never more meshlets or palette "
+                                                  "entries; the time grows with it)"),
     }
 
 METHOD_ITEMS = (
@@ -117,6 +124,7 @@ class SkinpackMeshletSettings(bpy.types.PropertyGroup):
     max_vertices: meshlet_limit_properties()["max_vertices"]
     max_triangles: meshlet_limit_properties()["max_triangles"]
     palette_size: meshlet_limit_properties()["palette_size"]
+    palette_effort: meshlet_limit_properties()["palette_effort"]
 
     # Stats of the preview shown (sp_meshlet_stats), read-only in the panel.
     valid: BoolProperty(default=False, options={'HIDDEN'})

@@ -2,7 +2,8 @@
 the colour attribute maps meshlets one-to-one onto colours (or joint counts onto the ramp), the
 stats on the object are the library's for the same input, the meshlets cover every triangle
 within the limits, the weights stay bit-identical, Clear removes everything, errors leave the
-mesh untouched, the preview is one undo step, and a Workbench render of the preview is a real
+mesh untouched, the preview is one undo step, Palette Effort reaches the library and lowers
+RE_Player's palette sum, and a Workbench render of the preview is a real
 picture (docs/images/meshlets_preview.png with --docs)."""
 
 import os
@@ -223,6 +224,33 @@ def check_triangulated(args):
         common.check(count == shown, "triangulated cylinder %s: %d meshlets, %d shown" % (builder, count, shown))
 
 
+def check_palette_effort(args):
+    """Palette Effort: the preview passes it to the library (the stats are those of a direct call with
+    it), and on RE_Player it lowers the palette sum at the same meshlet count."""
+    from skinpack import meshlet_preview
+    from skinpack.io import native
+    obj = common.open_asset(args, "RE_Player_female.blend", "RE_Player")
+    sums = {}
+    for effort in (0, 300):
+        common.check(bpy.ops.skinpack.preview_meshlets(mode='JOINTS', builder='SKIN', palette_effort=effort,
+                                                       **LIMITS) == {'FINISHED'}, "effort %d" % effort)
+        inputs = meshlet_preview.read_inputs(obj, obj.data.skinpack.max_influences)
+        options = native.meshlet_options('skin', LIMITS["max_vertices"], LIMITS["max_triangles"],
+                                         LIMITS["palette_size"], effort)
+        reference = native.meshlet_stats_dict(
+            native.build_meshlets(inputs.indices, inputs.positions, inputs.joints, inputs.weights, options).stats)
+        stats = obj.skinpack_meshlets
+        common.check(stats.meshlet_count == reference["meshlet_count"] and
+                     stats.mean_joints == np.float32(reference["mean_joints"]),
+                     "effort %d: the preview's stats are not the library's" % effort)
+        sums[effort] = (stats.meshlet_count, round(stats.mean_joints * stats.meshlet_count))
+    print("RE_Player palette effort 0 -> 300: %s -> %s meshlets / entries" % (sums[0], sums[300]))
+    common.check(sums[300][0] <= sums[0][0] and sums[300][1] < sums[0][1],
+                 "effort 300 did not lower the palette sum: %s -> %s" % (sums[0], sums[300]))
+    obj.skinpack_meshlets.palette_effort = 300
+    common.draw_skinpack_panel(obj)  # hands the setting to the preview buttons
+
+
 def render_preview(args):
     obj = common.open_asset(args, "RE_Player_female.blend", "RE_Player")
     bpy.ops.skinpack.preview_meshlets(mode='MESHLET', builder='SKIN')
@@ -260,6 +288,7 @@ def main():
     check_triangulated(args)
     check_one_preview_at_a_time(args)
     check_errors(args)
+    check_palette_effort(args)
     render_preview(args)
 
 

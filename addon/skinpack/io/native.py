@@ -545,13 +545,15 @@ def prepare_influences(joints, weights, joint_count, max_influences, sum_toleran
     return out_joints, out_weights
 
 
-def meshlet_options(builder=None, max_vertices=None, max_triangles=None, max_joints=None):
-    """sp_meshlet_options: the library's defaults with the builder and the limits that are given."""
+def meshlet_options(builder=None, max_vertices=None, max_triangles=None, max_joints=None, palette_effort=None):
+    """sp_meshlet_options: the library's defaults with the builder, the limits and the palette
+    effort that are given."""
     options = MeshletOptions()
     _require().sp_meshlet_options_default(ctypes.byref(options))
     if builder is not None:
         options.builder = MESHLET_BUILDERS.index(builder)
-    for name, value in (("max_vertices", max_vertices), ("max_triangles", max_triangles), ("max_joints", max_joints)):
+    for name, value in (("max_vertices", max_vertices), ("max_triangles", max_triangles), ("max_joints", max_joints),
+                        ("palette_effort", palette_effort)):
         if value is not None:
             setattr(options, name, value)
     return options
