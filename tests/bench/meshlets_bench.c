@@ -7,7 +7,8 @@
  * For each mesh and each limit pair (64 vertices with 124 and 126 triangles): meshoptimizer
  * 1.3's MeshoptClusterizer.buildMeshlets (cone weight 0; run by meshlets_mo13.mjs, which hands
  * back its meshlets), meshopt_buildMeshlets 0.18 (cone weight 0), the thesis's two builders at
- * palette cap 32 and our skin builder at palette caps 16 and 32, each with two weight sets: the
+ * palette cap 32 and our skin builder at palette caps 16 and 32 (and at cap 32 with palette_effort,
+ * SMALL_MESH_EFFORT / LARGE_MESH_EFFORT), each with two weight sets: the
  * prepared weights and the weights as compressed (mesh_data_decode_compressed: what
  * `skinpack compress --meshlets` builds from). meshoptimizer ignores weights: its splits are
  * built once and analysed with both. Every split gets the same analysis (palette = joints with
@@ -31,7 +32,10 @@
 #include <string.h>
 #include <time.h>
 
-enum { MAX_VERTICES = 64, ROWS = 6, SMALL_MESH_TRIANGLES = 20000, SMALL_MESH_REPS = 20 };
+enum { MAX_VERTICES = 64, ROWS = 7, SMALL_MESH_TRIANGLES = 20000, SMALL_MESH_REPS = 20 };
+/* The palette_effort row (cap 32): on the small meshes 1000, where the walk gains; on the
+ * subdivided ones 10, to show its time where it gains nothing (docs/meshlets.md). */
+enum { SMALL_MESH_EFFORT = 1000, LARGE_MESH_EFFORT = 10 };
 static const uint32_t triangle_limits[] = {124, 126};
 
 typedef struct row {
@@ -216,12 +220,16 @@ static split bench_meshopt_13(const mesh_data* mesh, const char* node, const cha
 }
 
 static row bench_ours(const meshlet_input* in, const char* name, uint32_t builder, uint32_t max_triangles,
-                      uint32_t palette, int reps)
+                      uint32_t palette, uint32_t effort, int reps)
 {
     sp_meshlet_options o = meshlet_options(builder, MAX_VERTICES, max_triangles, palette);
+    o.palette_effort = effort;
     meshlet_run run;
     row r = {"", 0, 0, 0, 0, 0, 0, 0, 1e30};
-    snprintf(r.builder, sizeof(r.builder), "%s, palette cap %u", name, palette);
+    if (effort)
+        snprintf(r.builder, sizeof(r.builder), "%s, palette cap %u, palette effort %u", name, palette, effort);
+    else
+        snprintf(r.builder, sizeof(r.builder), "%s, palette cap %u", name, palette);
     meshlet_run_build(&run, in, &o); /* allocates; the timed calls reuse the buffers */
     for (int i = 0; i < reps; ++i) {
         double start = cpu_ms();
@@ -334,20 +342,25 @@ typedef struct foreign_splits {
 } foreign_splits;
 
 /* Every builder on one weight set: rows[0] is meshoptimizer 1.3; stops if a split beats the bound.
- * Writes the summary line; returns the row count. */
+ * Writes the summary line (the default build's); returns the row count, *ours the default
+ * build's row at cap 32. */
 static int bench_weight_set(const char* name, const meshlet_input* in, const foreign_splits* foreign,
-                            uint32_t max_triangles, int reps, row rows[ROWS], joint_bound* bound, FILE* summary)
+                            uint32_t max_triangles, int reps, row rows[ROWS], int* ours, joint_bound* bound,
+                            FILE* summary)
 {
     int n = 0;
     rows[n++] = analyse_foreign_split(&foreign->mo13, in);
     if (foreign->has_018)
         rows[n++] = analyse_foreign_split(&foreign->mo018, in);
-    rows[n++] = bench_ours(in, "thesis naive", SP_MESHLETS_NAIVE, max_triangles, 32, reps);
-    rows[n++] = bench_ours(in, "thesis common influences", SP_MESHLETS_COMMON, max_triangles, 32, reps);
+    rows[n++] = bench_ours(in, "thesis naive", SP_MESHLETS_NAIVE, max_triangles, 32, 0, reps);
+    rows[n++] = bench_ours(in, "thesis common influences", SP_MESHLETS_COMMON, max_triangles, 32, 0, reps);
     const row* cap16 = &rows[n];
-    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 16, reps);
+    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 16, 0, reps);
     const row* cap32 = &rows[n];
-    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, reps);
+    *ours = n;
+    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, 0, reps);
+    uint32_t effort = in->index_count / 3 < SMALL_MESH_TRIANGLES ? SMALL_MESH_EFFORT : LARGE_MESH_EFFORT;
+    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, effort, reps);
 
     if (!joint_bound_compute(in, MAX_VERTICES, max_triangles, bound))
         die(name, "joint bound: out of memory");
@@ -436,9 +449,10 @@ static void bench_mesh(const bench_args* args, const char* name, const char* pat
          mesh->decoded_weights, mesh->decoded_influences}};
     row rows[WEIGHT_SETS][ROWS];
     joint_bound bounds[WEIGHT_SETS];
-    int n[WEIGHT_SETS];
+    int n[WEIGHT_SETS], ours[WEIGHT_SETS];
     for (int w = 0; w < WEIGHT_SETS; ++w)
-        n[w] = bench_weight_set(name, &sets[w], &foreign, max_triangles, reps, rows[w], &bounds[w], summary[w]);
+        n[w] = bench_weight_set(name, &sets[w], &foreign, max_triangles, reps, rows[w], &ours[w], &bounds[w],
+                                summary[w]);
     split_free(&foreign.mo13);
     split_free(&foreign.mo018);
 
@@ -454,7 +468,7 @@ static void bench_mesh(const bench_args* args, const char* name, const char* pat
                 weight_set_names[w], bounds[w].palette_sum, bounds[w].by_joint, bounds[w].forced_splits,
                 bounds[w].by_influence_count);
     for (int w = 0; w < WEIGHT_SETS; ++w)
-        print_fill_needed(details, name, &sets[w], max_triangles, &rows[w][0], &rows[w][n[w] - 1],
+        print_fill_needed(details, name, &sets[w], max_triangles, &rows[w][0], &rows[w][ours[w]],
                           weight_set_names[w]);
     fprintf(details, "| weights | builder | meshlets | ÷ mo 1.3 | palette entries | ÷ mo 1.3 | joint floor | max joints "
                      "| meshlets over 16 | over 32 | local tuple bits/vertex | ms | time ÷ mo 1.3 |\n"
