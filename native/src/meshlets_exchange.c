@@ -136,8 +136,7 @@ static int load_side(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, pair*
         p->triangle[i] = t;
         p->locked[i] = 0;
         for (int c = 0; c < 3; ++c) {
-            int repeated = (c == 1 && tri[1] == tri[0]) || (c == 2 && (tri[2] == tri[0] || tri[2] == tri[1]));
-            int v = repeated ? NO_CORNER : local_vertex(ctx, p, vertex_local, tri[c]);
+            int v = sp_meshlet_distinct_corner(tri, c) ? local_vertex(ctx, p, vertex_local, tri[c]) : NO_CORNER;
             if (v < 0)
                 return 0;
             p->corner[i][c] = (uint16_t)v;

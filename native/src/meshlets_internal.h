@@ -78,6 +78,13 @@ size_t sp_meshlet_tuple_ids(const sp_meshlet_context* ctx, uint64_t* set, uint32
  * over max_joints. */
 sp_result sp_meshlet_collect_triangle_joints(sp_meshlet_context* ctx, size_t* error_triangle);
 
+/* Whether corner c of tri is the first occurrence of its vertex (degenerate triangles repeat one,
+ * and a vertex is counted once per triangle). */
+static inline int sp_meshlet_distinct_corner(const uint32_t* tri, int c)
+{
+    return (c == 0) || (c == 1 && tri[1] != tri[0]) || (c == 2 && tri[2] != tri[0] && tri[2] != tri[1]);
+}
+
 /* New vertices triangle t would add to the open meshlet (inline: the builders' inner loop). */
 static inline uint32_t sp_meshlet_new_vertices(const sp_meshlet_context* ctx, size_t t)
 {

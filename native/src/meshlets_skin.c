@@ -115,18 +115,12 @@ size_t sp_meshlet_skin_builder_scratch_bound(size_t triangle_count, size_t verte
            (last > shared ? last : shared);
 }
 
-/* Whether corner c is the first occurrence of its vertex (degenerate triangles repeat one). */
-static int distinct_corner(const uint32_t* tri, int c)
-{
-    return (c == 0) || (c == 1 && tri[1] != tri[0]) || (c == 2 && tri[2] != tri[0] && tri[2] != tri[1]);
-}
-
 static void build_adjacency(const sp_meshlet_context* ctx, skin_state* s)
 {
     memset(s->live, 0, ctx->vertex_count * sizeof(uint32_t));
     for (size_t t = 0; t < ctx->triangle_count; ++t)
         for (int c = 0; c < 3; ++c)
-            if (distinct_corner(ctx->indices + t * 3, c))
+            if (sp_meshlet_distinct_corner(ctx->indices + t * 3, c))
                 s->live[ctx->indices[t * 3 + c]]++;
     uint32_t offset = 0;
     for (size_t v = 0; v < ctx->vertex_count; ++v) {
@@ -137,7 +131,7 @@ static void build_adjacency(const sp_meshlet_context* ctx, skin_state* s)
     s->adjacency_offset[ctx->vertex_count] = offset;
     for (size_t t = 0; t < ctx->triangle_count; ++t)
         for (int c = 0; c < 3; ++c)
-            if (distinct_corner(ctx->indices + t * 3, c)) {
+            if (sp_meshlet_distinct_corner(ctx->indices + t * 3, c)) {
                 uint32_t v = ctx->indices[t * 3 + c];
                 s->adjacency[s->adjacency_offset[v] + s->live[v]++] = (uint32_t)t;
             }
@@ -281,7 +275,7 @@ static void emit(sp_meshlet_context* ctx, skin_state* s, uint32_t t)
     s->emitted[t] = 1;
     s->last_rank = s->rank[t];
     for (int c = 0; c < 3; ++c) {
-        if (!distinct_corner(ctx->indices + t * 3, c))
+        if (!sp_meshlet_distinct_corner(ctx->indices + t * 3, c))
             continue;
         uint32_t v = ctx->indices[t * 3 + c];
         uint32_t* list = s->adjacency + s->adjacency_offset[v];

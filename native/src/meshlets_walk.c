@@ -106,12 +106,6 @@ static void leave(const sp_meshlet_context* ctx, walk* w, uint32_t v, uint32_t g
     add_carriers(ctx, w, v, g, -1);
 }
 
-/* Corner c of tri, unless it repeats an earlier one (degenerate triangles). */
-static int distinct_corner(const uint32_t* tri, int c)
-{
-    return c == 0 || (c == 1 && tri[1] != tri[0]) || (c == 2 && tri[2] != tri[0] && tri[2] != tri[1]);
-}
-
 /* Every meshlet's palette (as the common bookkeeping builds it) and vertex count, then the
  * meshlets around each vertex. */
 static void init_walk(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, walk* w)
@@ -134,7 +128,7 @@ static void init_walk(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, walk
     for (uint32_t t = 0; t < ctx->triangle_count; ++t) {
         const uint32_t* tri = ctx->indices + (size_t)t * 3;
         for (int c = 0; c < 3; ++c)
-            if (distinct_corner(tri, c))
+            if (sp_meshlet_distinct_corner(tri, c))
                 enter(ctx, w, tri[c], plan->owner[t]);
     }
     w->random = WALK_SEED;
@@ -149,7 +143,7 @@ static int can_join(const sp_meshlet_context* ctx, const sp_meshlet_plan* plan, 
     const uint32_t* tri = ctx->indices + (size_t)t * 3;
     uint32_t added = 0;
     for (int c = 0; c < 3; ++c) {
-        if (!distinct_corner(tri, c) || find_slot(w, tri[c], b) >= 0)
+        if (!sp_meshlet_distinct_corner(tri, c) || find_slot(w, tri[c], b) >= 0)
             continue;
         ++added;
         for (size_t s = 0; s < ctx->influences; ++s) {
@@ -169,7 +163,7 @@ static void move(sp_meshlet_context* ctx, sp_meshlet_plan* plan, walk* w, uint32
     const uint32_t* tri = ctx->indices + (size_t)t * 3;
     uint32_t a = plan->owner[t];
     for (int c = 0; c < 3; ++c)
-        if (distinct_corner(tri, c)) {
+        if (sp_meshlet_distinct_corner(tri, c)) {
             leave(ctx, w, tri[c], a);
             enter(ctx, w, tri[c], b);
         }
