@@ -39,9 +39,11 @@ size_t sp_meshlet_walk_scratch_bound(size_t triangle_count, size_t vertex_count)
 {
     size_t m = triangle_count; /* plan meshlets, at most */
     size_t entries = triangle_count * SP_MESHLET_TRIANGLE_JOINTS; /* a palette entry needs a triangle using it */
-    return 2 * sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + sp_meshlet_align8(vertex_count * sizeof(uint32_t)) +
-           sp_meshlet_align8((m + 1) * sizeof(uint32_t)) + 2 * sp_meshlet_align8(entries * sizeof(uint16_t)) +
-           sp_meshlet_align8(m * sizeof(uint16_t));
+    return 2 * sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + /* slot_group, slot_refs */
+           sp_meshlet_align8(vertex_count * sizeof(uint32_t)) +               /* groups_around */
+           sp_meshlet_align8((m + 1) * sizeof(uint32_t)) +                    /* palette_offset */
+           2 * sp_meshlet_align8(entries * sizeof(uint16_t)) +                /* palette, carriers */
+           sp_meshlet_align8(m * sizeof(uint16_t));                           /* vertices */
 }
 
 static uint64_t next_random(walk* w)

@@ -1,10 +1,10 @@
 /*
  * test_meshlets_assets.c - every builder at several limits on real skinned meshes exported by
  * export_mesh_data.py (label "meshlets"): the full meshlet_check on each output (every meshlet
- * within every limit, the palette cap included), determinism of
- * each builder (at 64/124/32), the skin builder with palette_effort, the palette-limit error on a
- * limit below the mesh's widest triangle, and that no builder's split goes below the joint lower bound (joint_bound.h) that
- * the benchmark uses to judge the joints-per-meshlet target.
+ * within every limit, the palette cap included), determinism of each builder (at 64/124/32),
+ * the skin builder with palette_effort, the palette-limit error on a limit below the mesh's
+ * widest triangle, and that no builder's split goes below the joint lower bound (joint_bound.h)
+ * that the benchmark uses to judge the joints-per-meshlet target.
  *
  *   test_meshlets_assets FILE.spmd...
  */
