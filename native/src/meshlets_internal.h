@@ -205,7 +205,7 @@ void sp_meshlet_plan_exchange(sp_meshlet_context* ctx, sp_meshlet_plan* plan, co
  * the receiving group (scratch: sp_meshlet_walk_scratch_bound bytes). */
 size_t sp_meshlet_walk_scratch_bound(size_t triangle_count, size_t vertex_count);
 void sp_meshlet_plan_walk(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
-                          unsigned char* scratch);
+                          const uint32_t* vertex_adjacency, unsigned char* scratch);
 /* Writes every group of the linked plan as one meshlet. */
 void sp_meshlet_plan_write(sp_meshlet_context* ctx, const sp_meshlet_plan* plan);
 

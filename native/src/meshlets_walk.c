@@ -7,7 +7,9 @@
  * joints the other meshlet already has can cross wherever that meshlet has room. Such moves
  * reshape the borders at no cost, and every so often the last vertex of a joint leaves a
  * meshlet and its palette shrinks. The walk proposes palette_effort x triangles such moves at
- * random (a triangle, one of its corners, another meshlet around that corner) and keeps every one
+ * random (a border vertex, a triangle around it, another meshlet around it: drawn from the
+ * border, no proposal is spent inside a meshlet: for the same palette sum on RE_Player 3x fewer
+ * instructions than drawing any triangle at 254 entries, 1.1x at 244) and keeps every one
  * that passes no limit and adds no joint to the receiving meshlet: the palette sum never rises,
  * no palette ever grows, no limit is ever passed, and a meshlet left empty disappears. The
  * random numbers come from a fixed seed, so a build stays reproducible.
@@ -28,6 +30,9 @@ typedef struct walk {
     uint32_t* slot_group;        /* per slot: a meshlet around the vertex */
     uint32_t* slot_refs;         /* per slot: that meshlet's triangles around the vertex */
     uint32_t* groups_around;     /* per vertex: slots in use */
+    uint32_t* border;            /* the vertices with two or more meshlets around them, in no order */
+    uint32_t* border_at;         /* per vertex: its place in border */
+    uint32_t border_count;
     uint32_t* palette_offset;    /* per meshlet: its first palette entry */
     uint16_t* palette;           /* joints of each meshlet's palette as built */
     uint16_t* carriers;          /* per palette entry: the meshlet's vertex slots that carry the joint */
@@ -40,7 +45,7 @@ size_t sp_meshlet_walk_scratch_bound(size_t triangle_count, size_t vertex_count)
     size_t m = triangle_count; /* plan meshlets, at most */
     size_t entries = triangle_count * SP_MESHLET_TRIANGLE_JOINTS; /* a palette entry needs a triangle using it */
     return 2 * sp_meshlet_align8(triangle_count * 3 * sizeof(uint32_t)) + /* slot_group, slot_refs */
-           sp_meshlet_align8(vertex_count * sizeof(uint32_t)) +               /* groups_around */
+           3 * sp_meshlet_align8(vertex_count * sizeof(uint32_t)) +           /* groups_around, border, border_at */
            sp_meshlet_align8((m + 1) * sizeof(uint32_t)) +                    /* palette_offset */
            2 * sp_meshlet_align8(entries * sizeof(uint16_t)) +                /* palette, carriers */
            sp_meshlet_align8(m * sizeof(uint16_t));                           /* vertices */
@@ -89,6 +94,10 @@ static void enter(const sp_meshlet_context* ctx, walk* w, uint32_t v, uint32_t g
         return;
     }
     uint32_t last = w->slot_offset[v] + w->groups_around[v]++;
+    if (w->groups_around[v] == 2) { /* onto the border */
+        w->border_at[v] = w->border_count;
+        w->border[w->border_count++] = v;
+    }
     w->slot_group[last] = g;
     w->slot_refs[last] = 1;
     w->vertices[g]++;
@@ -102,6 +111,11 @@ static void leave(const sp_meshlet_context* ctx, walk* w, uint32_t v, uint32_t g
     if (--w->slot_refs[slot] != 0)
         return;
     uint32_t last = w->slot_offset[v] + --w->groups_around[v];
+    if (w->groups_around[v] == 1) { /* off the border: the list's last vertex takes its place */
+        uint32_t moved = w->border[--w->border_count];
+        w->border[w->border_at[v]] = moved;
+        w->border_at[moved] = w->border_at[v];
+    }
     w->slot_group[slot] = w->slot_group[last];
     w->slot_refs[slot] = w->slot_refs[last];
     w->vertices[g]--;
@@ -127,6 +141,7 @@ static void init_walk(sp_meshlet_context* ctx, const sp_meshlet_plan* plan, walk
     }
     w->palette_offset[plan->count] = entries;
     memset(w->groups_around, 0, ctx->vertex_count * sizeof(uint32_t));
+    w->border_count = 0;
     for (uint32_t t = 0; t < ctx->triangle_count; ++t) {
         const uint32_t* tri = ctx->indices + (size_t)t * 3;
         for (int c = 0; c < 3; ++c)
@@ -187,7 +202,7 @@ static void relink(const sp_meshlet_context* ctx, sp_meshlet_plan* plan)
 }
 
 void sp_meshlet_plan_walk(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const uint32_t* vertex_adjacency_offset,
-                          unsigned char* scratch)
+                          const uint32_t* vertex_adjacency, unsigned char* scratch)
 {
     walk w;
     size_t t_count = ctx->triangle_count;
@@ -195,20 +210,20 @@ void sp_meshlet_plan_walk(sp_meshlet_context* ctx, sp_meshlet_plan* plan, const 
     w.slot_group = sp_meshlet_carve(&scratch, t_count * 3 * sizeof(uint32_t));
     w.slot_refs = sp_meshlet_carve(&scratch, t_count * 3 * sizeof(uint32_t));
     w.groups_around = sp_meshlet_carve(&scratch, ctx->vertex_count * sizeof(uint32_t));
+    w.border = sp_meshlet_carve(&scratch, ctx->vertex_count * sizeof(uint32_t));
+    w.border_at = sp_meshlet_carve(&scratch, ctx->vertex_count * sizeof(uint32_t));
     w.palette_offset = sp_meshlet_carve(&scratch, (t_count + 1) * sizeof(uint32_t));
     w.palette = sp_meshlet_carve(&scratch, t_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
     w.carriers = sp_meshlet_carve(&scratch, t_count * SP_MESHLET_TRIANGLE_JOINTS * sizeof(uint16_t));
     w.vertices = sp_meshlet_carve(&scratch, t_count * sizeof(uint16_t));
     init_walk(ctx, plan, &w);
     uint64_t proposals = (uint64_t)ctx->options.palette_effort * t_count;
-    for (uint64_t i = 0; i < proposals; ++i) {
-        uint64_t r = next_random(&w);
-        uint32_t t = (uint32_t)((r >> 8) % t_count);
-        uint32_t v = ctx->indices[(size_t)t * 3 + (r & 0xff) % 3];
-        uint32_t around = w.groups_around[v];
-        if (around < 2)
-            continue; /* not on a border */
-        uint32_t b = w.slot_group[w.slot_offset[v] + (uint32_t)(next_random(&w) % around)];
+    for (uint64_t i = 0; i < proposals && w.border_count > 0; ++i) {
+        /* a border vertex, a triangle around it, another meshlet around it */
+        uint32_t v = w.border[next_random(&w) % w.border_count];
+        uint32_t first = w.slot_offset[v], valence = w.slot_offset[v + 1] - first;
+        uint32_t t = vertex_adjacency[first + (uint32_t)(next_random(&w) % valence)];
+        uint32_t b = w.slot_group[first + (uint32_t)(next_random(&w) % w.groups_around[v])];
         if (b != plan->owner[t] && can_join(ctx, plan, &w, t, b))
             move(ctx, plan, &w, t, b);
     }

@@ -33,9 +33,10 @@
 #include <time.h>
 
 enum { MAX_VERTICES = 64, ROWS = 7, SMALL_MESH_TRIANGLES = 20000, SMALL_MESH_REPS = 20 };
-/* The palette_effort row (cap 32): on the small meshes 1000, where the walk gains; on the
- * subdivided ones 10, to show its time where it gains nothing (docs/meshlets.md). */
-enum { SMALL_MESH_EFFORT = 1000, LARGE_MESH_EFFORT = 10 };
+/* The palette_effort row (cap 32): on the small meshes 300, where the walk gains; on the
+ * subdivided ones 10, to show its time where it gains nothing (docs/meshlets.md). Its builds
+ * take 0.1-1 s, so a few runs time them. */
+enum { SMALL_MESH_EFFORT = 300, LARGE_MESH_EFFORT = 10, EFFORT_REPS = 3 };
 static const uint32_t triangle_limits[] = {124, 126};
 
 typedef struct row {
@@ -360,7 +361,8 @@ static int bench_weight_set(const char* name, const meshlet_input* in, const for
     *ours = n;
     rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, 0, reps);
     uint32_t effort = in->index_count / 3 < SMALL_MESH_TRIANGLES ? SMALL_MESH_EFFORT : LARGE_MESH_EFFORT;
-    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, effort, reps);
+    rows[n++] = bench_ours(in, "skinpack skin (ours)", SP_MESHLETS_SKIN, max_triangles, 32, effort,
+                           reps < EFFORT_REPS ? reps : EFFORT_REPS);
 
     if (!joint_bound_compute(in, MAX_VERTICES, max_triangles, bound))
         die(name, "joint bound: out of memory");
