@@ -323,7 +323,6 @@ static int exchange_pair(const sp_meshlet_context* ctx, sp_meshlet_plan* plan, p
             break;
         move(p, i);
         p->locked[i] = 1;
-        p->candidate[i / 64] &= ~(1ull << (i % 64));
         add_candidates_around(p, i);
         moved[steps++] = i;
         uint32_t joints = p->joints[0] + p->joints[1], vertices = p->vertices[0] + p->vertices[1];

@@ -742,8 +742,7 @@ void sp_meshlets_build_skin(sp_meshlet_context* ctx)
         /* the walk in the parts' and packing's bytes, free again; the borders it moved may give
          * the exchange new sequences (re_player at effort 10: 267 entries, then 263) */
         sp_meshlet_plan_walk(ctx, &s.plan, s.adjacency_offset, s.adjacency, cursor);
-        memset(s.live, 0, ctx->vertex_count * sizeof(uint32_t));
-        sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live);
+        sp_meshlet_plan_exchange(ctx, &s.plan, s.adjacency_offset, s.adjacency, s.live); /* live: left zero */
     }
     sp_meshlet_plan_write(ctx, &s.plan);
 }

@@ -18,10 +18,10 @@
 
 static const char* builder_names[SP_MESHLETS_BUILDER_COUNT] = {"naive", "common", "skin"};
 
-/* One builder at one limit set: the full check, the joint lower bound, determinism if asked.
- * Returns the number of failures. */
+/* One builder at one limit set: the full check, the joint lower bound, determinism if asked;
+ * its statistics into *stats if given. Returns the number of failures. */
 static int check_split(const char* path, const char* weights, const meshlet_input* in, sp_meshlet_options o,
-                       int determinism)
+                       int determinism, sp_meshlet_stats* stats)
 {
     meshlet_run run, again;
     meshlet_run_build(&run, in, &o);
@@ -46,6 +46,8 @@ static int check_split(const char* path, const char* weights, const meshlet_inpu
            path, weights, builder_names[o.builder], o.max_vertices, o.max_triangles, o.max_joints, ok ? "ok" : message,
            same ? "" : " NOT DETERMINISTIC", run.stats.meshlet_count, run.stats.mean_joints, run.stats.max_joints,
            run.stats.local_tuple_bits_mean, run.stats.global_tuple_bits);
+    if (stats)
+        *stats = run.stats;
     meshlet_run_free(&run);
     return !ok + !same;
 }
@@ -83,7 +85,8 @@ static int check_as_compressed(const char* path, mesh_data* mesh)
     int failures = bad != 0;
     for (uint32_t triangles = 124; triangles <= 126; triangles += 2)
         for (uint32_t cap = 16; cap <= 32; cap += 16)
-            failures += check_split(path, "as compressed ", &in, meshlet_options(SP_MESHLETS_SKIN, 64, triangles, cap), 0);
+            failures += check_split(path, "as compressed ", &in, meshlet_options(SP_MESHLETS_SKIN, 64, triangles, cap), 0,
+                                    NULL);
     return failures;
 }
 
@@ -96,18 +99,16 @@ static int check_palette_effort(const char* path, const meshlet_input* in)
     int failures = 0;
     for (uint32_t cap = 16; cap <= 32; cap += 16) {
         sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, cap);
-        meshlet_run base, walked;
+        meshlet_run base;
         meshlet_run_build(&base, in, &o);
         o.palette_effort = in->index_count / 3 < 20000 ? 300 : 2;
-        failures += check_split(path, "effort ", in, o, 1);
-        meshlet_run_build(&walked, in, &o);
-        int kept = walked.result == SP_OK && walked.stats.meshlet_count <= base.stats.meshlet_count &&
-                   walked.stats.joint_count <= base.stats.joint_count;
+        sp_meshlet_stats walked;
+        failures += check_split(path, "effort ", in, o, 1, &walked);
+        int kept = walked.meshlet_count <= base.stats.meshlet_count && walked.joint_count <= base.stats.joint_count;
         printf("%s effort %u, cap %u: %zu meshlets / %zu palette entries (effort 0: %zu / %zu)%s\n", path,
-               o.palette_effort, cap, walked.stats.meshlet_count, walked.stats.joint_count, base.stats.meshlet_count,
+               o.palette_effort, cap, walked.meshlet_count, walked.joint_count, base.stats.meshlet_count,
                base.stats.joint_count, kept ? "" : " MORE THAN WITHOUT");
         failures += !kept;
-        meshlet_run_free(&walked);
         meshlet_run_free(&base);
     }
     return failures;
@@ -128,7 +129,8 @@ static int check_file(const char* path)
     int failures = 0;
     for (uint32_t b = 0; b < SP_MESHLETS_BUILDER_COUNT; ++b)
         for (size_t l = 0; l < sizeof(limits) / sizeof(limits[0]); ++l)
-            failures += check_split(path, "", &in, meshlet_options(b, limits[l][0], limits[l][1], limits[l][2]), l == 0);
+            failures += check_split(path, "", &in, meshlet_options(b, limits[l][0], limits[l][1], limits[l][2]), l == 0,
+                                    NULL);
     failures += check_palette_effort(path, &in);
     failures += check_as_compressed(path, &mesh);
 

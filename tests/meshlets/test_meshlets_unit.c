@@ -467,6 +467,13 @@ static mesh checker_diagonals(const mesh* src, int side)
     return m;
 }
 
+/* A split as the golden tests hash it: every triangle's meshlet, then every palette. */
+static uint64_t split_hash(const meshlet_run* run, const meshlet_input* in)
+{
+    uint64_t hash = fnv1a(FNV1A_OFFSET, run->out.triangle_meshlet, in->index_count / 3 * sizeof(uint32_t));
+    return fnv1a(hash, run->out.joints, run->stats.joint_count * sizeof(uint16_t));
+}
+
 /* Golden splits: the skin builder's meshlet of every triangle and every palette, hashed, on a
  * regular and an irregular grid. The search's shortcuts (only border vertices scanned, each
  * candidate ranked once, far candidates skipped before their joints are counted) must not
@@ -490,8 +497,7 @@ static void test_skin_golden_splits(void)
         sp_meshlet_options o = meshlet_options(SP_MESHLETS_SKIN, 64, 124, 32);
         meshlet_run run;
         EXPECT(meshlet_run_build(&run, &in, &o) == SP_OK, "golden %s: build failed", cases[c].name);
-        uint64_t hash = fnv1a(FNV1A_OFFSET, run.out.triangle_meshlet, in.index_count / 3 * sizeof(uint32_t));
-        hash = fnv1a(hash, run.out.joints, run.stats.joint_count * sizeof(uint16_t));
+        uint64_t hash = split_hash(&run, &in);
         EXPECT(run.stats.meshlet_count == cases[c].meshlets && hash == cases[c].hash,
                "golden %s: %zu meshlets, split %016llx (%zu, %016llx)", cases[c].name, run.stats.meshlet_count,
                (unsigned long long)hash, cases[c].meshlets, (unsigned long long)cases[c].hash);
@@ -530,8 +536,7 @@ static void test_skin_palette_effort(void)
     meshlet_input in = input_of(&irregular);
     meshlet_run run;
     EXPECT(meshlet_run_build(&run, &in, &o) == SP_OK, "effort 100: build failed");
-    uint64_t hash = fnv1a(FNV1A_OFFSET, run.out.triangle_meshlet, in.index_count / 3 * sizeof(uint32_t));
-    hash = fnv1a(hash, run.out.joints, run.stats.joint_count * sizeof(uint16_t));
+    uint64_t hash = split_hash(&run, &in);
     EXPECT(hash == 0x44cdb4fe03ab9a5eull, "effort 100, irregular grid: split %016llx", (unsigned long long)hash);
     meshlet_run_free(&run);
     o.palette_effort = SP_MESHLET_MAX_PALETTE_EFFORT + 1;
