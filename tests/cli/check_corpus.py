@@ -3,7 +3,8 @@
     python3 check_corpus.py MODE --skinpack BIN --node NODE --validator tools/validate.mjs
                             --work DIR CORPUS_DIR
 
-MODE is info, fallback, compact, meshlets or meshopt (compact --meshopt). Every .gltf/.glb under CORPUS_DIR goes through
+MODE is info, fallback, compact, meshlets, meshlets_effort (meshlets --meshlet-effort 100) or meshopt
+(compact --meshopt). Every .gltf/.glb under CORPUS_DIR goes through
 `skinpack info` (info) or `skinpack compress` (the others) and every compressed output through
 `skinpack decompress`. A file fails the check when a command
 
@@ -305,6 +306,7 @@ def check_file(args, path):
             problems.append("info: " + (message if rc is None else "exit status %d: %s" % (rc, message[-300:])))
         return problems, written
     options = {"fallback": ["--fallback"], "compact": ["--compact"], "meshlets": ["--meshlets"],
+               "meshlets_effort": ["--meshlets", "--meshlet-effort", "100"],
                "meshopt": ["--compact", "--meshopt"]}[args.mode]
     out = output_name(args.work, args.corpus, path, args.mode)
     rc, message = run([args.skinpack, "compress", path, "-o", out] + options)
@@ -324,7 +326,7 @@ def check_file(args, path):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("mode", choices=["info", "fallback", "compact", "meshlets", "meshopt"])
+    parser.add_argument("mode", choices=["info", "fallback", "compact", "meshlets", "meshlets_effort", "meshopt"])
     parser.add_argument("--skinpack", required=True)
     parser.add_argument("--node", required=True)
     parser.add_argument("--validator", required=True)
